@@ -1,0 +1,105 @@
+#pragma once
+// Capillary (pendular liquid bridge) cohesion after Richefeu, El Youssoufi &
+// Radjaï, Phys. Rev. E 73, 051304 (2006), with the fit of Soulié et al.,
+// Int. J. Numer. Anal. Meth. Geomech. 30, 213 (2006); paper eqs 1-5.
+//
+//   f = -π γ √(R1 R2) [exp(A δ* + B) + C]   for δ* > 0
+//   f = -π γ √(R1 R2) [exp(B) + C]          for δ* ≤ 0            (eq 1)
+//   A = -1.1 V*^-0.53                                                (eq 2)
+//   B = (-0.148 ln V* - 0.96) θ² - 0.0082 ln V* + 0.48               (eq 3)
+//   C = 0.0018 ln V* + 0.078                                         (eq 4)
+//   δ* = δ/R2, V* = V_b/R2³, R1 ≤ R2, bridge breaks beyond
+//   δmax = (1 + θ/2) V_b^(1/3)                                       (eq 5)
+//
+// Sign: negative = attractive, as the paper writes eq 1.  The force acts along
+// the line of centres; the engine adds it to the contact law's normal force
+// (extraNormalForce), so it also raises the Coulomb friction limit μ|Fn|.
+//
+// Everything here is inline and allocation-free: it is called once per bonded
+// pair and time step.  Preconditions on the hot path (radii > 0, θ in radians)
+// are the caller's; validateCapillaryParameters() checks user input once.
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include "demLib/error.hpp"
+
+namespace dem {
+
+namespace capillary_detail {
+constexpr double pi = 3.14159265358979323846;
+}
+
+struct CapillaryParameters {
+    double surfaceTension = 0.072;  // γ [N/m], water at 20 °C
+    double contactAngle = 0.0;      // θ [rad]
+};
+
+// The fit coefficients of eqs 2-4 for a reduced bridge volume V* = V_b/R2³.
+struct CapillaryFitCoefficients {
+    double A;
+    double B;
+    double C;
+};
+
+inline CapillaryFitCoefficients capillaryFitCoefficients(double reducedVolume, double contactAngle) {
+    const double logVolume = std::log(reducedVolume);
+    const double thetaSquared = contactAngle * contactAngle;
+    return {-1.1 * std::pow(reducedVolume, -0.53),
+            (-0.148 * logVolume - 0.96) * thetaSquared - 0.0082 * logVolume + 0.48,
+            0.0018 * logVolume + 0.078};
+}
+
+// Eq 5: the gap beyond which the bridge of volume V_b is unstable and breaks.
+inline double debondingDistance(double bridgeVolume, double contactAngle) {
+    return (1.0 + 0.5 * contactAngle) * std::cbrt(bridgeVolume);
+}
+
+// Eq 1 between spheres of radii R1, R2 (either order) separated by `gap`
+// (surface-to-surface; negative when they overlap) and joined by a bridge of
+// volume `bridgeVolume`.  Zero when there is no liquid or gap > δmax (eq 5).
+inline double capillaryForce(double radius1, double radius2, double gap, double bridgeVolume,
+                             const CapillaryParameters& parameters) {
+    if (!(bridgeVolume > 0.0)) return 0.0;
+    if (gap > debondingDistance(bridgeVolume, parameters.contactAngle)) return 0.0;
+    if (radius1 > radius2) std::swap(radius1, radius2);  // the fit is written for R1 ≤ R2
+    const double largerRadius = radius2;
+    const double reducedVolume = bridgeVolume / (largerRadius * largerRadius * largerRadius);
+    const CapillaryFitCoefficients fit = capillaryFitCoefficients(reducedVolume, parameters.contactAngle);
+    const double reducedGap = gap / largerRadius;
+    const double shape = reducedGap > 0.0 ? std::exp(fit.A * reducedGap + fit.B) + fit.C
+                                          : std::exp(fit.B) + fit.C;
+    return -capillary_detail::pi * parameters.surfaceTension * std::sqrt(radius1 * radius2) * shape;
+}
+
+// The radius of the sphere pair that stands in for a sphere-plane bridge.
+// Eq 1 has no plane limit: √(R1 R2) diverges as R2 → ∞ while δ* and V* go to
+// zero.  In the thin-bridge (Derjaguin) picture the meniscus only sees the gap
+// profile h(r) = δ + r²/(2 R_eq) with 1/R_eq = 1/R1 + 1/R2; a plane gives
+// R_eq = R, two equal spheres of radius 2R give the same profile.  So a
+// particle-wall bridge is evaluated as the bridge between two spheres of
+// radius 2R.  At contact this doubles the equal-sphere force, as the classical
+// limits 2πγR cosθ (two spheres) and 4πγR cosθ (sphere-plane) require.
+inline double wallEquivalentRadius(double particleRadius) { return 2.0 * particleRadius; }
+
+// Particle-wall bridge: `gap` is the distance from the sphere surface to the
+// wall (negative when overlapping).  The debonding distance is eq 5 unchanged.
+inline double capillaryForceSphereWall(double particleRadius, double gap, double bridgeVolume,
+                                       const CapillaryParameters& parameters) {
+    const double equivalentRadius = wallEquivalentRadius(particleRadius);
+    return capillaryForce(equivalentRadius, equivalentRadius, gap, bridgeVolume, parameters);
+}
+
+// Checks user input once (not on the hot path).  The fit of eqs 2-4 was made
+// for wetting liquids, 0 ≤ θ < π/2.  `source` names the case file, if known.
+inline void validateCapillaryParameters(const CapillaryParameters& parameters,
+                                        const std::string& source = "capillary model") {
+    if (!(parameters.surfaceTension >= 0.0) || !std::isfinite(parameters.surfaceTension))
+        throw InputError(source + ": keyword 'surfaceTension' expects a finite number >= 0 [N/m], got " +
+                         std::to_string(parameters.surfaceTension));
+    if (!(parameters.contactAngle >= 0.0 && parameters.contactAngle < 0.5 * capillary_detail::pi))
+        throw InputError(source + ": keyword 'contactAngle' expects radians in [0, pi/2), got " +
+                         std::to_string(parameters.contactAngle));
+}
+
+}  // namespace dem

@@ -1,0 +1,61 @@
+#pragma once
+// Runs a case to its end time: insertions at their times, particle fields
+// (HDF5 + XDMF) and restart files at their intervals, a summary line per log
+// interval in <output>/summary.csv, and progress with an ETA on the console.
+// Used by the demRun front end and, one fluid step at a time, by diefillFoam.
+#include <chrono>
+#include <fstream>
+#include <memory>
+#include <ostream>
+#include <string>
+
+#include "demLib/case_setup.hpp"
+#include "demLib/field_output.hpp"
+
+namespace dem {
+
+struct RunOptions {
+    // Restart file to continue from; "latest" picks the newest of the case.
+    std::string restartFrom;
+    // Seconds of wall time between progress lines (0: none).
+    double progressInterval = 5.0;
+};
+
+class CaseRunner {
+public:
+    CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream& log);
+
+    // Advances to `time` (not beyond the case's end time).
+    void advanceTo(double time);
+    void runToEnd() { advanceTo(setup_.endTime); }
+    // Writes the final fields, restart file and summary line.
+    void finish();
+
+    Simulation& simulation() { return *simulation_; }
+    const CaseSetup& setup() const { return setup_; }
+    std::string outputDirectory() const;
+    std::string latestRestart() const;
+
+private:
+    void performDueInsertions();
+    void writeDueOutput(bool force);
+    void writeSummaryHeader();
+    void writeSummaryLine();
+    void writeRestart();
+    void progress(bool force);
+
+    CaseSetup setup_;
+    RunOptions options_;
+    std::ostream& log_;
+    std::unique_ptr<Simulation> simulation_;
+    std::unique_ptr<FieldOutput> fields_;
+    std::ofstream summary_;
+    std::size_t insertionsDone_ = 0;
+    long nextField_ = 0, nextLog_ = 0, nextRestart_ = 0;  // interval counters
+    long lastFieldStep_ = -1, lastLogStep_ = -1, lastRestartStep_ = -1;
+    double startTime_ = 0.0;
+    std::chrono::steady_clock::time_point wallStart_, lastProgress_;
+    long stepsAtStart_ = 0;
+};
+
+}  // namespace dem

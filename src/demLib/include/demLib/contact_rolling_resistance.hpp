@@ -1,0 +1,69 @@
+#pragma once
+// Rolling resistance models of LIGGGHTS 3.8 (src/rolling_model_cdt.h,
+// src/rolling_model_epsd.h, src/rolling_model_epsd2.h); Ai et al. 2011 models A
+// (CDT: constant directional torque) and C (EPSD: elastic-plastic spring-dashpot).
+// All torques returned here act on particle i; particle j receives the opposite.
+// omega is the relative angular velocity w_i - w_j (w_i for a wall).
+#include <cmath>
+
+#include "demLib/vec3.hpp"
+
+namespace dem {
+
+// CDT: M_i = -mu_r Fel L (w / |w|), then its component along n (torsion) is
+// removed.  Fel = kn d is the ELASTIC normal force (no damping, no cohesion);
+// L is R* for particle pairs and R - d/2 for walls (LIGGGHTS 'cri').
+// Note that the direction is normalised BEFORE the torsion part is removed, so
+// |M_i| = mu_r Fel L |w_t| / |w|.
+inline Vec3 cdtRollingTorque(const Vec3& omega, const Vec3& normal, double rollingFriction,
+                             double elasticNormalForce, double leverArm) noexcept {
+    const double omegaLength = omega.norm();
+    if (!(omegaLength > 0.0)) return Vec3::Zero();
+    const Vec3 torque = (rollingFriction * elasticNormalForce * leverArm / omegaLength) * omega;
+    return -(torque - torque.dot(normal) * normal);
+}
+
+// EPSD stiffness (Ai et al. 2011, eq. 14, 3D prefactor 2.25): kr = 2.25 kn mu_r^2 R*^2,
+// kn being the Hertz secant stiffness 4/3 Y* sqrt(R* d).
+inline double epsdRollingStiffness(double normalStiffness, double rollingFriction,
+                                   double radiusEff) noexcept {
+    return 2.25 * normalStiffness * rollingFriction * rollingFriction * radiusEff * radiusEff;
+}
+
+// EPSD2 stiffness (Iwashita & Oda 1998 as in LIGGGHTS): kr = kt R*^2.
+inline double epsd2RollingStiffness(double tangentialStiffness, double radiusEff) noexcept {
+    return tangentialStiffness * radiusEff * radiusEff;
+}
+
+// Rolling inertia used for the EPSD critical damping (3D):
+// I_r = 1/(1/(I_i + m_i R_i^2) + 1/(I_j + m_j R_j^2)), I = 0.4 m R^2 for a sphere.
+inline double rollingInertiaEff(double massI, double radiusI, double massJ,
+                                double radiusJ) noexcept {
+    const double reducedI = massI * radiusI * radiusI;
+    const double reducedJ = massJ * radiusJ * radiusJ;
+    return 1.4 * reducedI * reducedJ / (reducedI + reducedJ);
+}
+inline double rollingInertiaWall(double mass, double radius) noexcept {
+    return 1.4 * mass * radius * radius;
+}
+
+// EPSD and EPSD2 share this update.  springTorque (in ContactHistory, torque on i)
+// is advanced incrementally with the tangential part w_t of omega:
+//   M  -= kr w_t dt
+//   if |M| > Mmax:  M *= Mmax/|M|, stored, returned without damping (full mobilisation)
+//   else:           stored; returned M - c w_t  with c = eta_r 2 sqrt(I_r kr) (EPSD) or 0 (EPSD2)
+// Mmax = mu_r R* |Fn| with Fn the total normal force of the normal model.
+inline Vec3 elasticPlasticRollingTorque(Vec3& springTorque, const Vec3& omega, const Vec3& normal,
+                                        double dt, double rollingStiffness, double torqueLimit,
+                                        double viscousCoefficient) noexcept {
+    const Vec3 omegaTangential = omega - omega.dot(normal) * normal;
+    springTorque -= (rollingStiffness * dt) * omegaTangential;
+    const double springMagnitude = springTorque.norm();
+    if (springMagnitude > torqueLimit) {
+        springTorque *= torqueLimit / springMagnitude;
+        return springTorque;
+    }
+    return springTorque - viscousCoefficient * omegaTangential;
+}
+
+}  // namespace dem

@@ -1,0 +1,43 @@
+#pragma once
+// Tangential force with shear history and Coulomb truncation, as LIGGGHTS 3.8
+// does it (src/tangential_model_history.h, TangentialModel<TANGENTIAL_HISTORY>).
+//
+// Per step, in this order:
+//   1. s += vt dt                         (vt: tangential relative velocity at the contact)
+//   2. s -= (s.n) n                       (projection onto the current tangent plane;
+//                                          LIGGGHTS does NOT restore |s| afterwards)
+//   3. Ft = -kt s
+//   4. if kt|s| > mu|Fn|:  Ft *= mu|Fn| / (kt|s|),  s = -Ft/kt   (sliding, no damping)
+//      else:               Ft -= gt vt                           (sticking, with damping)
+// Ft is the force on particle i; j receives -Ft.
+#include <cmath>
+
+#include "demLib/vec3.hpp"
+
+namespace dem {
+
+// Advances `shear` (metres, lives in ContactHistory) and returns the tangential
+// force on i.  frictionLimit = mu |Fn| >= 0 is decided by the caller.
+inline Vec3 tangentialHistoryForce(Vec3& shear, const Vec3& normal, const Vec3& tangentialVelocity,
+                                   double dt, double tangentialStiffness, double tangentialDamping,
+                                   double frictionLimit) noexcept {
+    shear += tangentialVelocity * dt;
+    shear -= shear.dot(normal) * normal;
+
+    const double shearLength = shear.norm();
+    Vec3 force = -tangentialStiffness * shear;
+    const double elasticMagnitude = tangentialStiffness * shearLength;
+    if (elasticMagnitude > frictionLimit) {
+        if (shearLength != 0.0) {
+            force *= frictionLimit / elasticMagnitude;
+            shear = -force / tangentialStiffness;
+        } else {
+            force.setZero();
+        }
+    } else {
+        force -= tangentialDamping * tangentialVelocity;
+    }
+    return force;
+}
+
+}  // namespace dem

@@ -1,0 +1,21 @@
+#pragma once
+// Errors that demLib reports to its callers.  InputError is for anything a user
+// wrote (a case file, a keyword, a value): its message names the file, the
+// keyword and what was expected, and front ends print it and exit non-zero.
+#include <stdexcept>
+#include <string>
+
+namespace dem {
+
+class InputError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+// A state the engine cannot continue from (NaN, lost contact with reality).
+class RuntimeError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+}  // namespace dem

@@ -1,0 +1,48 @@
+#pragma once
+// A small RAII layer over the HDF5 C API: just what demLib's field output and
+// restart files need (2D double/int datasets, scalar attributes, groups).
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "demLib/vec3.hpp"
+
+namespace dem {
+
+class Hdf5File {
+public:
+    enum class Mode { Create, Read };
+    Hdf5File(const std::string& path, Mode mode);
+    ~Hdf5File();
+    Hdf5File(const Hdf5File&) = delete;
+    Hdf5File& operator=(const Hdf5File&) = delete;
+
+    const std::string& path() const { return path_; }
+
+    void createGroup(const std::string& name);
+    bool exists(const std::string& name) const;
+
+    void write(const std::string& name, const std::vector<double>& data, std::size_t columns = 1);
+    void write(const std::string& name, const std::vector<std::int64_t>& data, std::size_t columns = 1);
+    void write(const std::string& name, const std::vector<int>& data, std::size_t columns = 1);
+    void write(const std::string& name, const std::vector<Vec3>& data);
+
+    std::vector<double> readDoubles(const std::string& name, std::size_t* columns = nullptr) const;
+    std::vector<std::int64_t> readInt64(const std::string& name) const;
+    std::vector<int> readInts(const std::string& name) const;
+    std::vector<Vec3> readVec3(const std::string& name) const;
+
+    // Scalar attributes on the root group.
+    void setAttribute(const std::string& name, double value);
+    void setAttribute(const std::string& name, std::int64_t value);
+    void setAttribute(const std::string& name, const std::string& value);
+    double doubleAttribute(const std::string& name) const;
+    std::int64_t intAttribute(const std::string& name) const;
+    std::string stringAttribute(const std::string& name) const;
+
+private:
+    std::string path_;
+    std::int64_t file_ = -1;  // hid_t
+};
+
+}  // namespace dem

@@ -1,0 +1,136 @@
+#pragma once
+// The DEM engine's front door: configuration structs in, state and fields out.
+// A Simulation owns the particles, the walls, the contact lists and the force
+// kernel, and advances them with velocity Verlet.
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "demLib/contact_force_kernel.hpp"
+#include "demLib/insertion.hpp"
+#include "demLib/interaction_properties.hpp"
+#include "demLib/liquid_bridges.hpp"
+#include "demLib/particle_particle_neighbor_list.hpp"
+#include "demLib/particle_store.hpp"
+#include "demLib/particle_wall_contacts.hpp"
+#include "demLib/wall.hpp"
+
+namespace dem {
+
+struct AxisAlignedBox {
+    Vec3 min = Vec3::Zero();
+    Vec3 max = Vec3::Zero();
+    bool contains(const Vec3& x) const {
+        return (x.array() >= min.array()).all() && (x.array() <= max.array()).all();
+    }
+};
+
+struct SimulationSettings {
+    double timeStep = 1e-5;
+    Vec3 gravity = Vec3(0.0, 0.0, -9.81);
+    ForceFieldSettings forces;
+    // Which pairs hold liquid bridges and how the water is shared (capillary only).
+    LiquidBridgeSettings bridges;
+    // Verlet skin as a fraction of the largest particle diameter.
+    double skinFraction = 0.2;
+    // The time step must not exceed this fraction of the Rayleigh time of the
+    // smallest particle (LIGGGHTS warns above 0.2) unless explicitly allowed.
+    double maxRayleighFraction = 0.2;
+    bool allowLargeTimeStep = false;
+    // Particles whose centre leaves this box are removed and counted as lost.
+    std::optional<AxisAlignedBox> domain;
+    // Name of the input the settings came from, for error messages.
+    std::string source = "demLib";
+};
+
+struct StepStatistics {
+    ContactStatistics contacts;
+    std::size_t lostThisStep = 0;
+};
+
+// Capillary liquid bookkeeping; volumes in m^3.  total = bridges + pool always.
+struct LiquidState {
+    double totalVolume = 0.0;   // water added, conserved
+    double poolVolume = 0.0;    // not held by any bridge (redistributed at list updates)
+    double waterContent = 0.0;  // mass of water / mass of dry solid
+    std::size_t bridgeCount = 0;
+};
+
+class Simulation {
+public:
+    Simulation(SimulationSettings settings, std::vector<Material> materials, InteractionTable interactions,
+               std::vector<Wall> walls);
+
+    // Adds particles (positions, radii) of one material with one velocity.
+    // Throws InputError for a non-positive radius, a particle inside a wall, or
+    // a time step too large for the new particles' contact stiffness.
+    void insert(const std::vector<InsertedParticle>& particles, int materialIndex, const Vec3& velocity,
+                const std::string& context = "insertion");
+
+    // Sets the water content w (mass of water / mass of dry solid) of the
+    // particles present now; the liquid is spread over bridges at the next step.
+    void setWaterContent(double w);
+
+    void step(long steps = 1);
+
+    double time() const { return time_; }
+    long stepCount() const { return step_; }
+    double timeStep() const { return settings_.timeStep; }
+    const SimulationSettings& settings() const { return settings_; }
+    ParticleStore& particles() { return particles_; }
+    const ParticleStore& particles() const { return particles_; }
+    const std::vector<Wall>& walls() const { return walls_; }
+    const std::vector<Material>& materials() const { return materials_; }
+    const InteractionTable& interactions() const { return interactions_; }
+    const ParticleParticleNeighborList& pairList() const { return pairs_; }
+    const ParticleWallContacts& wallContacts() const { return wallContacts_; }
+    const StepStatistics& lastStep() const { return last_; }
+    const LiquidState& liquid() const { return liquid_; }
+    std::size_t lostCount() const { return lost_; }
+    double lostMass() const { return lostMass_; }
+    std::int64_t nextId() const { return nextId_; }
+
+    // Liquid volume held by bridges plus the free pool (conserved quantity).
+    double liquidInBridges() const;
+    // Mean number of capillary bridges per particle (liquid coordination number).
+    double liquidCoordinationNumber() const;
+    // Mean number of touching contacts per particle.
+    double coordinationNumber() const;
+
+    // Largest time step the settings accept for the particles present.
+    double maxAllowedTimeStep() const;
+
+    // Restart: the whole state, contact history included.
+    void writeRestart(const std::string& path) const;
+    void readRestart(const std::string& path);
+
+private:
+    void checkTimeStep(const std::string& context) const;
+    void removeLostParticles();
+    void updatePairList();
+    void redistributeLiquid();
+    void computeForces();
+
+    SimulationSettings settings_;
+    std::vector<Material> materials_;
+    InteractionTable interactions_;
+    std::vector<Wall> walls_;
+    ParticleStore particles_;
+    ParticleParticleNeighborList pairs_;
+    ParticleWallContacts wallContacts_;
+    std::unique_ptr<ContactForceKernel> kernel_;
+    double time_ = 0.0;
+    long step_ = 0;
+    std::int64_t nextId_ = 0;
+    std::size_t lost_ = 0;
+    double lostMass_ = 0.0;
+    bool forcesValid_ = false;
+    LiquidState liquid_;
+    std::unique_ptr<LiquidBridgeNetwork> liquidNetwork_;
+    double largestBridge_ = 0.0;
+    StepStatistics last_;
+};
+
+}  // namespace dem

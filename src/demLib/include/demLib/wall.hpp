@@ -1,0 +1,41 @@
+#pragma once
+// The wall type the DEM engine loops over: a static shape in its reference
+// frame plus a prescribed rigid motion.  A query transforms the sphere centre
+// into the reference frame (inverse pose), asks the shape, and maps each
+// contact back to the world frame, adding the wall velocity at the contact
+// point.  Feature ids are those of the shape, so contact history keyed by
+// (particle, wall, feature) survives the motion.
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "demLib/triangle_mesh.hpp"
+#include "demLib/vec3.hpp"
+#include "demLib/wall_contact.hpp"
+#include "demLib/wall_cylinder.hpp"
+#include "demLib/wall_motion.hpp"
+#include "demLib/wall_plane.hpp"
+
+namespace dem {
+
+using WallShape = std::variant<PlaneWall, CylinderWall, MeshWall>;
+
+struct Wall {
+    std::string name;
+    WallShape shape;
+    WallMotion motion;
+    int materialIndex = 0;
+
+    // Appends the contacts of a sphere at world position `centre` at `time`
+    // (nothing once the wall is removed).  World-frame normal, point and wall velocity.
+    void findContacts(const Vec3& centre, double radius, double time, std::vector<WallContact>& out) const;
+
+    // World-frame axis-aligned box enclosing the wall at `time` (unbounded for
+    // planes, empty once removed).  A sphere whose box misses it has no
+    // contact with this wall.
+    BoundingBox boundingBox(double time) const;
+
+    bool isActive(double time) const { return motion.isActive(time); }
+};
+
+}  // namespace dem

@@ -1,0 +1,87 @@
+#pragma once
+// Prescribed rigid motion of a wall: a sequence of non-overlapping segments,
+// each active on [tStart, tEnd), that either translate the wall with a constant
+// velocity or rotate it with a constant angular velocity about an axis fixed in
+// the world frame.  Between and after segments the wall rests where the last
+// finished segment left it.  Poses are evaluated in closed form from the segment
+// list (never by summing per-step increments), so a restarted run at time t
+// sees exactly the same wall as an uninterrupted one.
+//
+// Reference frame: the wall's geometry is given at t = -infinity (before every
+// segment); x_world = R(t) x_ref + c(t).
+#include <limits>
+#include <vector>
+
+#include "demLib/vec3.hpp"
+
+namespace dem {
+
+struct RigidTransform {
+    Mat3 rotation = Mat3::Identity();
+    Vec3 translation = Vec3::Zero();
+
+    Vec3 apply(const Vec3& referencePoint) const { return rotation * referencePoint + translation; }
+    Vec3 applyToDirection(const Vec3& referenceDirection) const { return rotation * referenceDirection; }
+    Vec3 applyInverse(const Vec3& worldPoint) const {
+        return rotation.transpose() * (worldPoint - translation);
+    }
+    Vec3 applyInverseToDirection(const Vec3& worldDirection) const {
+        return rotation.transpose() * worldDirection;
+    }
+    // (after ∘ this): first this transform, then `after`.
+    RigidTransform followedBy(const RigidTransform& after) const {
+        return {after.rotation * rotation, after.rotation * translation + after.translation};
+    }
+};
+
+struct MotionSegment {
+    enum class Kind { Translate, Rotate };
+    Kind kind = Kind::Translate;
+    double tStart = 0.0;
+    double tEnd = 0.0;
+    Vec3 velocity = Vec3::Zero();       // Translate: m/s
+    Vec3 axisPoint = Vec3::Zero();      // Rotate: a point on the axis (world frame)
+    Vec3 axisDirection = Vec3::UnitZ(); // Rotate: unit axis (world frame), right-hand rule
+    double angularVelocity = 0.0;       // Rotate: rad/s
+
+    // Pose change produced by `duration` seconds of this segment.
+    RigidTransform displacement(double duration) const;
+};
+
+class WallMotion {
+public:
+    // A wall that never moves and is never removed.
+    WallMotion() = default;
+
+    // Appends a segment.  Segments must be added in time order and must not
+    // overlap (tStart >= previous tEnd).  Throws InputError otherwise, or when
+    // tEnd <= tStart, a value is not finite, or the rotation axis is zero.  The
+    // axis direction need not be unit length; it is normalised.
+    void addTranslation(double tStart, double tEnd, const Vec3& velocity);
+    void addRotation(double tStart, double tEnd, const Vec3& axisPoint, const Vec3& axisDirection,
+                     double angularVelocity);
+
+    // From time `t` on, the wall no longer exists (isActive(t) == false).
+    void setRemovalTime(double t);
+    double removalTime() const { return removalTime_; }
+    bool isActive(double t) const { return t < removalTime_; }
+
+    bool isStatic() const { return segments_.empty(); }
+    const std::vector<MotionSegment>& segments() const { return segments_; }
+
+    // Pose at time t: x_world = R x_ref + c.
+    RigidTransform at(double t) const;
+    // Velocity of the wall material that is at `worldPoint` at time t:
+    // v for a translation, omega x (p - axisPoint) for a rotation, 0 at rest.
+    Vec3 velocityAt(const Vec3& worldPoint, double t) const;
+
+private:
+    void append(const MotionSegment& segment);
+
+    std::vector<MotionSegment> segments_;
+    // poseAfter_[i]: pose once segments 0..i have all finished.
+    std::vector<RigidTransform> poseAfter_;
+    double removalTime_ = std::numeric_limits<double>::infinity();
+};
+
+}  // namespace dem

@@ -1,0 +1,218 @@
+#include "demLib/case_runner.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iomanip>
+#include <sstream>
+#include <vector>
+
+#include "demLib/error.hpp"
+
+namespace dem {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string formatDuration(double seconds) {
+    std::ostringstream s;
+    const long t = static_cast<long>(std::lround(seconds));
+    if (t >= 3600) s << t / 3600 << "h" << std::setw(2) << std::setfill('0') << (t % 3600) / 60 << "m";
+    else if (t >= 60) s << t / 60 << "m" << std::setw(2) << std::setfill('0') << t % 60 << "s";
+    else s << t << "s";
+    return s.str();
+}
+
+// Index of the first multiple of `interval` strictly after `time`.
+long firstIndexAfter(double time, double interval) {
+    return interval > 0.0 ? static_cast<long>(std::floor(time / interval + 1e-9)) + 1 : 0;
+}
+
+}  // namespace
+
+CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream& log)
+    : setup_(std::move(setup)), options_(options), log_(log) {
+    simulation_ = makeSimulation(setup_);
+    const fs::path out = outputDirectory();
+    fs::create_directories(out / "restart");
+
+    std::string restart = options_.restartFrom;
+    if (restart == "latest") {
+        restart = latestRestart();
+        if (restart.empty())
+            throw InputError("-restart latest: no restart file found in '" + (out / "restart").string() + "'");
+    }
+    if (!restart.empty()) {
+        simulation_->readRestart(restart);
+        startTime_ = simulation_->time();
+        // Insertions at or before the restart time are in the restart file.
+        for (const InsertionSpec& s : setup_.insertions)
+            if (s.time <= startTime_) ++insertionsDone_;
+        log_ << "Continuing from restart file " << restart << " at t = " << startTime_ << " s, step "
+             << simulation_->stepCount() << ", " << simulation_->particles().size() << " particles\n";
+    }
+    fields_ = std::make_unique<FieldOutput>(out.string(), "particles", restart.empty() ? -1.0 : startTime_);
+
+    // The summary keeps the lines up to the restart time and continues after them.
+    const fs::path summaryPath = out / "summary.csv";
+    std::vector<std::string> kept;
+    if (!restart.empty() && fs::exists(summaryPath)) {
+        std::ifstream in(summaryPath);
+        std::string line;
+        while (std::getline(in, line)) {
+            if (kept.empty()) { kept.push_back(line); continue; }
+            if (std::stod(line.substr(0, line.find(','))) <= startTime_ + 1e-12) kept.push_back(line);
+        }
+    }
+    summary_.open(summaryPath, std::ios::trunc);
+    if (!summary_) throw InputError("cannot write '" + summaryPath.string() + "'");
+    summary_ << std::setprecision(10);
+    if (kept.empty()) writeSummaryHeader();
+    else for (const std::string& l : kept) summary_ << l << "\n";
+
+    nextField_ = firstIndexAfter(startTime_, setup_.output.fieldInterval);
+    nextLog_ = firstIndexAfter(startTime_, setup_.output.logInterval);
+    nextRestart_ = firstIndexAfter(startTime_, setup_.output.restartInterval);
+
+    if (restart.empty()) {
+        performDueInsertions();
+        if (setup_.waterContent > 0.0) {
+            simulation_->setWaterContent(setup_.waterContent);
+            log_ << "Water content " << setup_.waterContent << ": " << simulation_->liquid().totalVolume
+                 << " m^3 of liquid\n";
+        }
+        writeDueOutput(true);
+    }
+    wallStart_ = lastProgress_ = std::chrono::steady_clock::now();
+    stepsAtStart_ = simulation_->stepCount();
+}
+
+std::string CaseRunner::outputDirectory() const {
+    return (fs::path(setup_.caseDir) / setup_.output.directory).string();
+}
+
+std::string CaseRunner::latestRestart() const {
+    const fs::path pointer = fs::path(outputDirectory()) / "restart" / "latest";
+    std::ifstream in(pointer);
+    std::string name;
+    if (!(in >> name)) return {};
+    const fs::path file = fs::path(outputDirectory()) / "restart" / name;
+    return fs::exists(file) ? file.string() : std::string();
+}
+
+void CaseRunner::performDueInsertions() {
+    while (insertionsDone_ < setup_.insertions.size()) {
+        const InsertionSpec& spec = setup_.insertions[insertionsDone_];
+        if (spec.time > simulation_->time() + 1e-12) break;
+        const std::size_t n = performInsertion(*simulation_, spec);
+        double mass = 0.0;
+        const ParticleStore& p = simulation_->particles();
+        for (std::size_t i = p.size() - n; i < p.size(); ++i) mass += p.mass[i];
+        log_ << "Inserted " << n << " particles (" << mass * 1e3 << " g) of '" << spec.name << "' at t = "
+             << simulation_->time() << " s\n";
+        ++insertionsDone_;
+    }
+}
+
+void CaseRunner::writeSummaryHeader() {
+    summary_ << "time,step,particles,kineticEnergy,coordinationNumber,wallContacts,lostCount,lostMass";
+    if (setup_.waterContent > 0.0)
+        summary_ << ",liquidTotal,liquidInBridges,liquidPool,liquidRelativeError,bridges,liquidCoordinationNumber";
+    for (const MonitorRegion& r : setup_.output.regions) summary_ << ",mass_" << r.name;
+    summary_ << "\n";
+}
+
+void CaseRunner::writeSummaryLine() {
+    const Simulation& s = *simulation_;
+    const ParticleStore& p = s.particles();
+    summary_ << s.time() << "," << s.stepCount() << "," << p.size() << "," << p.kineticEnergy() << ","
+             << s.coordinationNumber() << "," << s.lastStep().contacts.wallContacts << "," << s.lostCount() << ","
+             << s.lostMass();
+    if (setup_.waterContent > 0.0) {
+        const LiquidState& l = s.liquid();
+        const double inBridges = s.liquidInBridges();
+        const double error = l.totalVolume > 0.0 ? (inBridges + l.poolVolume - l.totalVolume) / l.totalVolume : 0.0;
+        summary_ << "," << l.totalVolume << "," << inBridges << "," << l.poolVolume << "," << error << ","
+                 << l.bridgeCount << "," << s.liquidCoordinationNumber();
+    }
+    for (const MonitorRegion& r : setup_.output.regions) summary_ << "," << massInRegion(p, *r.region);
+    summary_ << "\n";
+    summary_.flush();
+    lastLogStep_ = s.stepCount();
+}
+
+void CaseRunner::writeRestart() {
+    const fs::path dir = fs::path(outputDirectory()) / "restart";
+    std::ostringstream name;
+    name << "restart_" << std::setw(9) << std::setfill('0') << simulation_->stepCount() << ".h5";
+    simulation_->writeRestart((dir / name.str()).string());
+    const fs::path pointer = dir / "latest";
+    {
+        std::ofstream out(pointer.string() + ".writing");
+        out << name.str() << "\n";
+    }
+    fs::rename(pointer.string() + ".writing", pointer);
+    lastRestartStep_ = simulation_->stepCount();
+}
+
+void CaseRunner::writeDueOutput(bool force) {
+    const double t = simulation_->time();
+    const double eps = 0.5 * simulation_->timeStep();
+    const OutputSpec& o = setup_.output;
+    const long step = simulation_->stepCount();
+    if ((o.fieldInterval > 0.0 && t >= nextField_ * o.fieldInterval - eps) || (force && lastFieldStep_ != step)) {
+        fields_->write(*simulation_);
+        lastFieldStep_ = step;
+        nextField_ = firstIndexAfter(t + eps, o.fieldInterval);
+    }
+    if ((o.logInterval > 0.0 && t >= nextLog_ * o.logInterval - eps) || (force && lastLogStep_ != step)) {
+        writeSummaryLine();
+        nextLog_ = firstIndexAfter(t + eps, o.logInterval);
+    }
+    if (o.restartInterval > 0.0 && t >= nextRestart_ * o.restartInterval - eps) {
+        writeRestart();
+        nextRestart_ = firstIndexAfter(t + eps, o.restartInterval);
+    }
+}
+
+void CaseRunner::progress(bool force) {
+    if (options_.progressInterval <= 0.0 && !force) return;
+    const auto now = std::chrono::steady_clock::now();
+    const double sinceLast = std::chrono::duration<double>(now - lastProgress_).count();
+    if (!force && sinceLast < options_.progressInterval) return;
+    lastProgress_ = now;
+    const Simulation& s = *simulation_;
+    const double elapsed = std::chrono::duration<double>(now - wallStart_).count();
+    const double done = s.time() - startTime_;
+    const double remaining = setup_.endTime - s.time();
+    const double eta = done > 0.0 ? elapsed * remaining / done : 0.0;
+    const double particleSteps = static_cast<double>(s.stepCount() - stepsAtStart_) * s.particles().size();
+    log_ << std::fixed << std::setprecision(4) << "t = " << s.time() << " s (" << std::setprecision(1)
+         << 100.0 * s.time() / setup_.endTime << " %)" << std::defaultfloat << std::setprecision(6)
+         << "  step " << s.stepCount() << "  particles " << s.particles().size() << "  KE "
+         << s.particles().kineticEnergy() << " J  lost " << s.lostCount() << "  "
+         << std::setprecision(3) << (elapsed > 0 ? particleSteps / elapsed : 0.0) << " particle-steps/s"
+         << "  elapsed " << formatDuration(elapsed) << "  ETA " << formatDuration(eta) << std::endl;
+}
+
+void CaseRunner::advanceTo(double time) {
+    const double target = std::min(time, setup_.endTime);
+    Simulation& s = *simulation_;
+    const double dt = s.timeStep();
+    while (s.time() < target - 0.5 * dt) {
+        s.step(1);
+        performDueInsertions();
+        writeDueOutput(false);
+        progress(false);
+    }
+}
+
+void CaseRunner::finish() {
+    writeDueOutput(true);
+    if (lastRestartStep_ != simulation_->stepCount()) writeRestart();
+    progress(true);
+}
+
+}  // namespace dem

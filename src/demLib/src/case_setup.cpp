@@ -1,0 +1,356 @@
+#include "demLib/case_setup.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include "demLib/error.hpp"
+#include "demLib/triangle_mesh.hpp"
+
+namespace dem {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr double pi = 3.14159265358979323846;
+
+std::string resolve(const std::string& caseDir, const std::string& file) {
+    const fs::path p(file);
+    return p.is_absolute() ? file : (fs::path(caseDir) / p).string();
+}
+
+[[noreturn]] void invalid(const Dictionary& d, const std::string& key, const std::string& expected) {
+    throw InputError(d.describe(key) + ": " + expected);
+}
+
+// Materials are referred to by name; the message lists the defined ones.
+int materialByName(const Dictionary& d, const std::string& key, const std::vector<Material>& materials) {
+    std::vector<std::string> names;
+    for (const Material& m : materials) names.push_back(m.name);
+    const std::string name = d.getChoice(key, names);
+    return static_cast<int>(std::find(names.begin(), names.end(), name) - names.begin());
+}
+
+Vec3 unitVector(const Dictionary& d, const std::string& key) {
+    const Vec3 v = d.get<Vec3>(key);
+    if (!(v.norm() > 0.0)) invalid(d, key, "expected a non-zero direction vector");
+    return v.normalized();
+}
+
+std::shared_ptr<const TriangleMesh> readStl(const Dictionary& d, const std::string& caseDir) {
+    const std::string file = resolve(caseDir, d.get<std::string>("file"));
+    const double scale = d.has("scale") ? d.getPositive("scale") : 1.0;
+    if (!fs::exists(file)) invalid(d, "file", "the STL file '" + file + "' does not exist");
+    return std::make_shared<const TriangleMesh>(TriangleMesh::fromStl(file, scale));
+}
+
+std::shared_ptr<Region> readRegion(const Dictionary& d, const std::string& caseDir) {
+    const std::string type = d.getChoice("type", {"box", "cylinder", "stl"});
+    if (type == "box") {
+        const Vec3 lo = d.get<Vec3>("min");
+        const Vec3 hi = d.get<Vec3>("max");
+        if (!((hi.array() > lo.array()).all())) invalid(d, "max", "expected max > min in every component");
+        return std::make_shared<Region>(Region::box(lo, hi));
+    }
+    if (type == "cylinder") {
+        const Vec3 point = d.get<Vec3>("axisPoint");
+        const Vec3 axis = unitVector(d, "axis");
+        const double radius = d.getPositive("radius");
+        const std::vector<double> range = d.get<std::vector<double>>("range");
+        if (range.size() != 2 || !(range[1] > range[0]))
+            invalid(d, "range", "expected (axialMin axialMax) with axialMax > axialMin");
+        return std::make_shared<Region>(Region::cylinder(point, axis, radius, range[0], range[1]));
+    }
+    auto mesh = readStl(d, caseDir);
+    const BoundingBox box = mesh->boundingBox();
+    return std::make_shared<Region>(
+        Region::predicate([mesh](const Vec3& x) { return mesh->containsPoint(x); }, box.lower, box.upper));
+}
+
+WallMotion readMotion(const Dictionary& wall) {
+    WallMotion motion;
+    if (wall.has("motion")) {
+        const Dictionary& m = wall.subDict("motion");
+        for (const std::string& segmentName : m.keys()) {
+            const Dictionary& s = m.subDict(segmentName);
+            const std::string type = s.getChoice("type", {"translate", "rotate"});
+            const double start = s.getNonNegative("start");
+            const double end = s.getPositive("end");
+            if (!(end > start)) invalid(s, "end", "expected end > start");
+            if (type == "translate") {
+                motion.addTranslation(start, end, s.get<Vec3>("velocity"));
+            } else {
+                const double degreesPerSecond = s.get<double>("angularVelocity");
+                motion.addRotation(start, end, s.get<Vec3>("axisPoint"), unitVector(s, "axis"),
+                                   degreesPerSecond * pi / 180.0);
+            }
+        }
+    }
+    if (wall.has("removeAt")) motion.setRemovalTime(wall.getNonNegative("removeAt"));
+    return motion;
+}
+
+std::vector<Wall> readWalls(const Dictionary& root, const std::string& caseDir,
+                            const std::vector<Material>& materials) {
+    std::vector<Wall> walls;
+    if (!root.has("walls")) return walls;
+    const Dictionary& all = root.subDict("walls");
+    for (const std::string& name : all.keys()) {
+        const Dictionary& d = all.subDict(name);
+        const int material = materialByName(d, "material", materials);
+        const std::string type = d.getChoice("type", {"plane", "cylinder", "stl"});
+        auto shape = [&]() -> WallShape {
+            if (type == "plane") return PlaneWall(d.get<Vec3>("point"), unitVector(d, "normal"));
+            if (type == "cylinder") {
+                const std::vector<double> range = d.get<std::vector<double>>("range");
+                if (range.size() != 2 || !(range[1] > range[0]))
+                    invalid(d, "range", "expected (axialMin axialMax) with axialMax > axialMin");
+                const std::string side = d.getChoice("side", {"inside", "outside"});
+                return CylinderWall(d.get<Vec3>("axisPoint"), unitVector(d, "axis"), d.getPositive("radius"),
+                                    range[0], range[1],
+                                    side == "inside" ? CylinderWall::Side::Inside : CylinderWall::Side::Outside);
+            }
+            return MeshWall(readStl(d, caseDir));
+        };
+        Wall w{name, shape(), WallMotion(), material};
+        w.motion = readMotion(d);
+        walls.push_back(std::move(w));
+    }
+    return walls;
+}
+
+std::shared_ptr<SizeDistribution> readDistribution(const Dictionary& d, double scale, const std::string& context) {
+    if (d.has("diameter") && d.has("sizeDistribution"))
+        invalid(d, "diameter", "give either 'diameter' (monodisperse) or 'sizeDistribution', not both");
+    if (d.has("diameter"))
+        return std::make_shared<SizeDistribution>(SizeDistribution::monodisperse(d.getPositive("diameter"), scale, context));
+    if (!d.has("sizeDistribution"))
+        invalid(d, "sizeDistribution", "missing; expected 'diameter <d>;' or 'sizeDistribution { classes ((dMin dMax massPercent) ...); }'");
+    const Dictionary& s = d.subDict("sizeDistribution");
+    const auto rows = s.get<std::vector<std::vector<double>>>("classes");
+    std::vector<SizeClassPercent> table;
+    for (const auto& row : rows) {
+        if (row.size() != 3) invalid(s, "classes", "expected rows of three numbers (dMin dMax massPercent)");
+        table.push_back({row[0], row[1], row[2]});
+    }
+    const std::string within = s.has("withinClass")
+                                   ? s.getChoice("withinClass", {"uniformDiameter", "uniformVolume"})
+                                   : std::string("uniformDiameter");
+    return std::make_shared<SizeDistribution>(SizeDistribution::fromPercentages(
+        table, scale, within == "uniformVolume" ? WithinClass::UniformVolume : WithinClass::UniformDiameter,
+        s.describe("classes")));
+}
+
+std::vector<InsertionSpec> readInsertions(const Dictionary& root, const CaseSetup& setup) {
+    std::vector<InsertionSpec> out;
+    if (!root.has("insertion")) return out;
+    const Dictionary& all = root.subDict("insertion");
+    for (const std::string& name : all.keys()) {
+        const Dictionary& d = all.subDict(name);
+        InsertionSpec spec;
+        spec.name = name;
+        spec.context = d.describe("region").substr(0, d.describe("region").find(", keyword")) + ", insertion '" + name + "'";
+        spec.materialIndex = materialByName(d, "material", setup.materials);
+        spec.time = d.has("time") ? d.getNonNegative("time") : 0.0;
+        spec.region = readRegion(d.subDict("region"), setup.caseDir);
+        spec.distribution = readDistribution(d, setup.coarseGrain.factor, spec.context);
+        const bool byMass = d.has("mass");
+        const bool byCount = d.has("count");
+        if (byMass == byCount) invalid(d, "mass", "give exactly one of 'mass' (kg) and 'count'");
+        InsertionRequest& r = spec.request;
+        if (byMass) r.targetMass = d.getPositive("mass");
+        else {
+            const long count = d.get<long>("count");
+            if (count <= 0) invalid(d, "count", "expected a positive number of particles");
+            r.targetCount = static_cast<std::size_t>(count);
+        }
+        r.density = setup.materials[spec.materialIndex].density;
+        r.initialVelocity = d.getOrDefault<Vec3>("velocity", Vec3::Zero());
+        const long seed = d.getOrDefault<long>("seed", 1L);
+        if (seed < 0) invalid(d, "seed", "expected a non-negative integer");
+        r.placement.seed = static_cast<std::uint64_t>(seed);
+        r.placement.gapFraction = d.has("gapFraction") ? d.getNonNegative("gapFraction") : 0.05;
+        const std::string lattice = d.has("lattice") ? d.getChoice("lattice", {"hexagonalClose", "simpleCubic"})
+                                                     : std::string("hexagonalClose");
+        r.placement.lattice = lattice == "simpleCubic" ? Lattice::SimpleCubic : Lattice::HexagonalClose;
+        const std::string packing = d.has("packing") ? d.getChoice("packing", {"random", "settled"})
+                                                     : std::string("settled");
+        r.placement.settleDirection = packing == "settled" ? setup.settings.gravity : Vec3::Zero();
+        r.placement.context = spec.context;
+        out.push_back(std::move(spec));
+    }
+    return out;
+}
+
+}  // namespace
+
+int CaseSetup::materialIndex(const std::string& name) const {
+    for (std::size_t i = 0; i < materials.size(); ++i)
+        if (materials[i].name == name) return static_cast<int>(i);
+    return -1;
+}
+
+CaseSetup readCaseSetup(const std::string& caseDir) {
+    const std::string file = (fs::path(caseDir) / "constant" / "demProperties").string();
+    if (!fs::exists(file))
+        throw InputError("case '" + caseDir + "': missing file constant/demProperties (expected the DEM setup of the case there)");
+    return readCaseSetup(Dictionary::fromFile(file), caseDir);
+}
+
+CaseSetup readCaseSetup(const Dictionary& root, const std::string& caseDir) {
+    CaseSetup c;
+    c.caseDir = caseDir;
+    c.propertiesFile = root.fileName();
+
+    const Dictionary& sim = root.subDict("simulation");
+    SimulationSettings& s = c.settings;
+    s.source = root.fileName();
+    s.timeStep = sim.getPositive("timeStep");
+    c.endTime = sim.getPositive("endTime");
+    s.gravity = sim.get<Vec3>("gravity");
+    if (sim.has("skinFraction")) s.skinFraction = sim.getInRange("skinFraction", 1e-3, 2.0);
+    if (sim.has("maxRayleighFraction")) s.maxRayleighFraction = sim.getInRange("maxRayleighFraction", 1e-3, 1.0);
+    s.allowLargeTimeStep = sim.getOrDefault<bool>("allowLargeTimeStep", false);
+    if (sim.has("domain")) {
+        const Dictionary& box = sim.subDict("domain");
+        AxisAlignedBox b{box.get<Vec3>("min"), box.get<Vec3>("max")};
+        if (!((b.max.array() > b.min.array()).all())) invalid(box, "max", "expected max > min in every component");
+        s.domain = b;
+    }
+
+    const Dictionary& model = root.subDict("contactModel");
+    model.getChoice("normal", {"hertz"});
+    model.getChoice("tangential", {"history"});
+    const std::string rolling = model.getChoice("rolling", {"none", "cdt", "epsd", "epsd2"});
+    s.forces.rolling = rolling == "cdt"     ? RollingModel::CDT
+                       : rolling == "epsd"  ? RollingModel::EPSD
+                       : rolling == "epsd2" ? RollingModel::EPSD2
+                                            : RollingModel::None;
+
+    if (root.has("coarseGrain")) {
+        const Dictionary& cg = root.subDict("coarseGrain");
+        c.coarseGrain.factor = cg.get<double>("factor");
+        c.coarseGrain.capillaryExponent = cg.getOrDefault<double>("capillaryExponent", paperCapillaryExponent);
+        validateCoarseGrainSettings(c.coarseGrain, cg.describe("factor"));
+    }
+
+    if (root.has("cohesion")) {
+        const Dictionary& coh = root.subDict("cohesion");
+        const std::string m = coh.getChoice("model", {"none", "capillary"});
+        if (m == "capillary") {
+            s.forces.cohesion = CohesionModel::Capillary;
+            c.waterContent = coh.getInRange("waterContent", 0.0, 1.0);
+            s.forces.capillary.surfaceTension = coh.getOrDefault<double>("surfaceTension", 0.072);
+            const double degrees = coh.getOrDefault<double>("contactAngle", 0.0);
+            if (!(degrees >= 0.0 && degrees < 90.0)) invalid(coh, "contactAngle", "expected degrees in [0, 90)");
+            s.forces.capillary.contactAngle = degrees * pi / 180.0;
+            validateCapillaryParameters(s.forces.capillary, coh.describe("surfaceTension"));
+            s.bridges.contactAngle = s.forces.capillary.contactAngle;
+            const std::string formation =
+                coh.has("bridgeFormation")
+                    ? coh.getChoice("bridgeFormation", {"withinDebondingDistance", "contactThenPersist"})
+                    : std::string("withinDebondingDistance");
+            s.bridges.formation = formation == "contactThenPersist" ? BridgeFormation::ContactThenPersist
+                                                                     : BridgeFormation::WithinDebondingDistance;
+            const std::string weight = coh.has("volumeWeight")
+                                           ? coh.getChoice("volumeWeight", {"diameterProduct", "diameterSum"})
+                                           : std::string("diameterProduct");
+            s.bridges.weight = weight == "diameterSum" ? BridgeVolumeWeight::DiameterSumTimesDistance
+                                                       : BridgeVolumeWeight::DiameterProductTimesDistance;
+            s.forces.capillaryForceScale =
+                coarseGrainCapillaryFactor(c.coarseGrain.factor, c.coarseGrain.capillaryExponent);
+        }
+    }
+
+    const Dictionary& mats = root.subDict("materials");
+    for (const std::string& name : mats.keys()) {
+        const Dictionary& m = mats.subDict(name);
+        Material mat;
+        mat.name = name;
+        mat.youngsModulus = m.getPositive("youngsModulus");
+        mat.poissonRatio = m.getInRange("poissonRatio", 0.0, 0.5);
+        mat.density = m.getPositive("density");
+        c.materials.push_back(mat);
+    }
+    if (c.materials.empty()) invalid(root, "materials", "expected at least one material");
+
+    c.interactions = InteractionTable(c.materials.size());
+    const Dictionary& inter = root.subDict("interactions");
+    for (const std::string& key : inter.keys()) {
+        const std::size_t dash = key.find('-');
+        const int a = dash == std::string::npos ? -1 : c.materialIndex(key.substr(0, dash));
+        const int b = dash == std::string::npos ? -1 : c.materialIndex(key.substr(dash + 1));
+        if (a < 0 || b < 0)
+            invalid(inter, key, "expected an entry named '<material>-<material>' with defined materials");
+        if (c.interactions.isSet(a, b)) invalid(inter, key, "this pair of materials is already defined");
+        const Dictionary& p = inter.subDict(key);
+        PairCoefficients coeff;
+        coeff.restitution = p.getInRange("restitution", 1e-6, 1.0);
+        coeff.friction = p.getNonNegative("friction");
+        coeff.rollingFriction = p.getOrDefault<double>("rollingFriction", 0.0);
+        coeff.rollingViscousDamping = p.getOrDefault<double>("rollingViscousDamping", 0.0);
+        if (s.forces.rolling != RollingModel::None && !p.has("rollingFriction"))
+            invalid(p, "rollingFriction", "missing; the rolling model '" + rolling + "' needs it");
+        c.interactions.set(c.materials, a, b, coeff);
+    }
+    try {
+        c.interactions.requireComplete(c.materials);
+    } catch (const InputError& e) {
+        throw InputError(inter.describe("") + ": " + e.what());
+    }
+
+    c.walls = readWalls(root, caseDir, c.materials);
+    c.insertions = readInsertions(root, c);
+
+    if (root.has("output")) {
+        const Dictionary& o = root.subDict("output");
+        c.output.directory = o.getOrDefault("directory", "dem");
+        c.output.fieldInterval = o.has("fieldInterval") ? o.getNonNegative("fieldInterval") : 0.0;
+        c.output.logInterval = o.has("logInterval") ? o.getNonNegative("logInterval") : 0.0;
+        c.output.restartInterval = o.has("restartInterval") ? o.getNonNegative("restartInterval") : 0.0;
+        if (o.has("regions")) {
+            const Dictionary& regions = o.subDict("regions");
+            for (const std::string& name : regions.keys())
+                c.output.regions.push_back({name, readRegion(regions.subDict(name), caseDir)});
+        }
+    }
+    root.checkNoUnusedKeys();
+    return c;
+}
+
+std::unique_ptr<Simulation> makeSimulation(const CaseSetup& setup) {
+    return std::make_unique<Simulation>(setup.settings, setup.materials, setup.interactions, setup.walls);
+}
+
+std::size_t performInsertion(Simulation& sim, const InsertionSpec& spec) {
+    InsertionRequest request = spec.request;
+    const ParticleStore& p = sim.particles();
+    request.placement.existing.positions = &p.position;
+    request.placement.existing.radii = &p.radius;
+    const double time = sim.time();
+    const std::vector<Wall>& walls = sim.walls();
+    request.placement.clearance = [&walls, time](const Vec3& x, double r) {
+        std::vector<WallContact> touching;
+        for (const Wall& w : walls) {
+            if (!w.isActive(time)) continue;
+            w.findContacts(x, r, time, touching);
+            for (const WallContact& c : touching)
+                if (c.overlap > 0.0) return false;
+            touching.clear();
+        }
+        return true;
+    };
+    const std::vector<InsertedParticle> placed = insertParticles(*spec.region, *spec.distribution, request);
+    sim.insert(placed, spec.materialIndex, request.initialVelocity, spec.context);
+    return placed.size();
+}
+
+double massInRegion(const ParticleStore& particles, const Region& region) {
+    double m = 0.0;
+    for (std::size_t i = 0; i < particles.size(); ++i)
+        if (region.containsSphere(particles.position[i], 0.0)) m += particles.mass[i];
+    return m;
+}
+
+}  // namespace dem

@@ -1,0 +1,243 @@
+#include "demLib/contact_force_kernel.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+namespace dem {
+
+namespace {
+
+int maxThreads() {
+#ifdef _OPENMP
+    return omp_get_max_threads();
+#else
+    return 1;
+#endif
+}
+
+int threadIndex() {
+#ifdef _OPENMP
+    return omp_get_thread_num();
+#else
+    return 0;
+#endif
+}
+
+template <RollingModel Rolling, CohesionModel Cohesion>
+class ContactForceKernelImpl final : public ContactForceKernel {
+public:
+    using Law = ContactLaw<Rolling>;
+    explicit ContactForceKernelImpl(const ForceFieldSettings& s) : ContactForceKernel(s) {}
+
+    ContactStatistics compute(ParticleStore& p, ParticleParticleNeighborList& pairs,
+                              ParticleWallContacts& wallContacts, const std::vector<Wall>& walls,
+                              const InteractionTable& interactions, double time, double dt) override {
+        const int n = static_cast<int>(p.size());
+        const int threads = std::max(1, std::min(maxThreads(), n / 64 + 1));
+        // Thread 0 accumulates into the particle arrays; the others into their own
+        // buffers, added afterwards in thread order: the sums, and so the results,
+        // are the same in every run with the same thread count.
+        buffers_.resize(threads);
+        for (int t = 1; t < threads; ++t) {
+            buffers_[t].force.assign(n, Vec3::Zero());
+            buffers_[t].torque.assign(n, Vec3::Zero());
+        }
+        std::vector<ContactStatistics> stats(threads);
+        std::vector<std::vector<WallContactRecord>> newWall(threads);
+
+#pragma omp parallel num_threads(threads)
+        {
+            const int t = threadIndex();
+            Vec3* force = t == 0 ? p.force.data() : buffers_[t].force.data();
+            Vec3* torque = t == 0 ? p.torque.data() : buffers_[t].torque.data();
+            const int begin = static_cast<int>(static_cast<long>(n) * t / threads);
+            const int end = static_cast<int>(static_cast<long>(n) * (t + 1) / threads);
+            pairForces(p, pairs, interactions, dt, begin, end, force, torque, stats[t]);
+            wallForces(p, wallContacts, walls, interactions, time, dt, begin, end, force, torque,
+                       newWall[t], stats[t]);
+        }
+
+        ContactStatistics total;
+        std::size_t wallCount = 0;
+        for (int t = 0; t < threads; ++t) {
+            total.touchingPairs += stats[t].touchingPairs;
+            total.wallContacts += stats[t].wallContacts;
+            total.bridges += stats[t].bridges;
+            total.releasedLiquid += stats[t].releasedLiquid;
+            wallCount += newWall[t].size();
+        }
+        for (int t = 1; t < threads; ++t) {
+#pragma omp parallel for schedule(static) num_threads(threads)
+            for (int i = 0; i < n; ++i) {
+                p.force[i] += buffers_[t].force[i];
+                p.torque[i] += buffers_[t].torque[i];
+            }
+        }
+        auto& records = wallContacts.records();
+        records.clear();
+        records.reserve(wallCount);
+        for (auto& block : newWall) records.insert(records.end(), block.begin(), block.end());
+        return total;
+    }
+
+private:
+    struct Buffer {
+        std::vector<Vec3> force;
+        std::vector<Vec3> torque;
+    };
+    std::vector<Buffer> buffers_;
+
+    void pairForces(ParticleStore& p, ParticleParticleNeighborList& pairs,
+                    const InteractionTable& interactions, double dt, int begin, int end, Vec3* force,
+                    Vec3* torque, ContactStatistics& stats) const {
+        const auto& offsets = pairs.offsets();
+        const auto& neighbors = pairs.neighbors();
+        auto& state = pairs.state();
+        for (int i = begin; i < end; ++i) {
+            const Vec3 xi = p.position[i];
+            const double ri = p.radius[i];
+            Vec3 fi = Vec3::Zero();
+            Vec3 ti = Vec3::Zero();
+            for (int k = offsets[i]; k < offsets[i + 1]; ++k) {
+                const int j = neighbors[k];
+                PairState& s = state[k];
+                const Vec3 d = xi - p.position[j];
+                const double rj = p.radius[j];
+                const double radiusSum = ri + rj;
+                const double dist2 = d.squaredNorm();
+                if constexpr (Cohesion == CohesionModel::None) {
+                    if (dist2 >= radiusSum * radiusSum) {
+                        s.contact = ContactHistory{};
+                        continue;
+                    }
+                }
+                const double dist = std::sqrt(dist2);
+                const Vec3 normal = d / dist;
+                const double overlap = radiusSum - dist;
+
+                double cohesiveForce = 0.0;
+                if constexpr (Cohesion == CohesionModel::Capillary) {
+                    if (s.bridgeVolume > 0.0) {
+                        const double gap = -overlap;
+                        if (gap > debondingDistance(s.bridgeVolume, settings_.capillary.contactAngle)) {
+                            stats.releasedLiquid += s.bridgeVolume;  // back to the free liquid
+                            s.bridgeVolume = 0.0;
+                        } else {
+                            cohesiveForce = settings_.capillaryForceScale *
+                                            capillaryForce(ri, rj, gap, s.bridgeVolume, settings_.capillary);
+                            ++stats.bridges;
+                        }
+                    }
+                    if (overlap <= 0.0) {
+                        s.contact = ContactHistory{};
+                        if (cohesiveForce != 0.0) {
+                            const Vec3 f = cohesiveForce * normal;
+                            fi += f;
+                            force[j] -= f;
+                        }
+                        continue;
+                    }
+                }
+                ++stats.touchingPairs;
+                // Lever arms to the contact point, as LIGGGHTS (radius − δ/2).
+                const double ci = ri - 0.5 * overlap;
+                const double cj = rj - 0.5 * overlap;
+                ContactKinematics kin;
+                kin.normal = normal;
+                kin.overlap = overlap;
+                kin.radiusEff = ri * rj / radiusSum;
+                kin.massEff = p.mass[i] * p.mass[j] / (p.mass[i] + p.mass[j]);
+                kin.relVelocity = p.velocity[i] - p.velocity[j] - (ci * p.omega[i] + cj * p.omega[j]).cross(normal);
+                kin.relOmega = p.omega[i] - p.omega[j];
+                kin.dt = dt;
+                if constexpr (Rolling == RollingModel::EPSD)
+                    kin.rollingInertiaEff = rollingInertiaEff(p.mass[i], ri, p.mass[j], rj);
+                const ContactForces f =
+                    Law::evaluate(kin, interactions(p.material[i], p.material[j]), s.contact, cohesiveForce);
+                fi += f.force;
+                force[j] -= f.force;
+                const Vec3 nxFt = normal.cross(f.tangentialForce);
+                ti += -ci * nxFt + f.rollingTorque;
+                torque[j] += -cj * nxFt - f.rollingTorque;
+            }
+            force[i] += fi;
+            torque[i] += ti;
+        }
+    }
+
+    void wallForces(ParticleStore& p, const ParticleWallContacts& old, const std::vector<Wall>& walls,
+                    const InteractionTable& interactions, double time, double dt, int begin, int end,
+                    Vec3* force, Vec3* torque, std::vector<WallContactRecord>& out,
+                    ContactStatistics& stats) const {
+        std::vector<WallContact> found;
+        const int wallCount = static_cast<int>(walls.size());
+        std::vector<BoundingBox> boxes(wallCount);
+        std::vector<char> active(wallCount);
+        for (int w = 0; w < wallCount; ++w) {
+            active[w] = walls[w].isActive(time);
+            if (active[w]) boxes[w] = walls[w].boundingBox(time);
+        }
+        for (int i = begin; i < end; ++i) {
+            const std::size_t first = out.size();
+            const Vec3 xi = p.position[i];
+            const double ri = p.radius[i];
+            for (int w = 0; w < wallCount; ++w) {
+                if (!active[w] || !boxes[w].overlapsSphere(xi, ri)) continue;
+                found.clear();
+                walls[w].findContacts(xi, ri, time, found);
+                for (const WallContact& c : found) {
+                    if (c.overlap <= 0.0) continue;
+                    ++stats.wallContacts;
+                    WallContactRecord rec;
+                    rec.particle = i;
+                    rec.wall = w;
+                    rec.feature = c.feature;
+                    if (const WallContactRecord* prev = old.find(i, w, c.feature)) rec.history = prev->history;
+                    const double ci = ri - 0.5 * c.overlap;
+                    ContactKinematics kin;
+                    kin.normal = c.normal;
+                    kin.overlap = c.overlap;
+                    kin.radiusEff = ri;
+                    kin.massEff = p.mass[i];
+                    kin.relVelocity = p.velocity[i] - ci * p.omega[i].cross(c.normal) - c.wallVelocity;
+                    kin.relOmega = p.omega[i];
+                    kin.dt = dt;
+                    kin.isWall = true;
+                    if constexpr (Rolling == RollingModel::EPSD)
+                        kin.rollingInertiaEff = rollingInertiaWall(p.mass[i], ri);
+                    const ContactForces f =
+                        Law::evaluate(kin, interactions(p.material[i], walls[w].materialIndex), rec.history, 0.0);
+                    force[i] += f.force;
+                    torque[i] += -ci * c.normal.cross(f.tangentialForce) + f.rollingTorque;
+                    out.push_back(rec);
+                }
+            }
+            std::sort(out.begin() + first, out.end());
+        }
+    }
+};
+
+template <RollingModel R>
+std::unique_ptr<ContactForceKernel> makeWithRolling(const ForceFieldSettings& s) {
+    if (s.cohesion == CohesionModel::Capillary)
+        return std::make_unique<ContactForceKernelImpl<R, CohesionModel::Capillary>>(s);
+    return std::make_unique<ContactForceKernelImpl<R, CohesionModel::None>>(s);
+}
+
+}  // namespace
+
+std::unique_ptr<ContactForceKernel> makeContactForceKernel(const ForceFieldSettings& s) {
+    switch (s.rolling) {
+        case RollingModel::None: return makeWithRolling<RollingModel::None>(s);
+        case RollingModel::CDT: return makeWithRolling<RollingModel::CDT>(s);
+        case RollingModel::EPSD: return makeWithRolling<RollingModel::EPSD>(s);
+        case RollingModel::EPSD2: return makeWithRolling<RollingModel::EPSD2>(s);
+    }
+    return nullptr;
+}
+
+}  // namespace dem

@@ -1,0 +1,26 @@
+#include "demLib/integrator.hpp"
+
+namespace dem {
+
+void kickAndDrift(ParticleStore& p, double dt) {
+    const double half = 0.5 * dt;
+    const std::size_t n = p.size();
+#pragma omp parallel for schedule(static)
+    for (std::size_t i = 0; i < n; ++i) {
+        p.velocity[i] += (half * p.invMass[i]) * p.force[i];
+        p.omega[i] += (half * p.invInertia[i]) * p.torque[i];
+        p.position[i] += dt * p.velocity[i];
+    }
+}
+
+void kick(ParticleStore& p, double dt) {
+    const double half = 0.5 * dt;
+    const std::size_t n = p.size();
+#pragma omp parallel for schedule(static)
+    for (std::size_t i = 0; i < n; ++i) {
+        p.velocity[i] += (half * p.invMass[i]) * p.force[i];
+        p.omega[i] += (half * p.invInertia[i]) * p.torque[i];
+    }
+}
+
+}  // namespace dem

@@ -1,0 +1,171 @@
+#include "demLib/liquid_bridges.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "demLib/capillary_force.hpp"
+#include "demLib/error.hpp"
+
+namespace dem {
+
+namespace {
+
+// Neumaier's compensated sum: the liquid budget must close to ~1e-16, not to
+// N·1e-16, however many bonds there are.
+class CompensatedSum {
+public:
+    void add(double value) {
+        const double total = sum_ + value;
+        if (std::abs(sum_) >= std::abs(value))
+            compensation_ += (sum_ - total) + value;
+        else
+            compensation_ += (value - total) + sum_;
+        sum_ = total;
+    }
+    double value() const { return sum_ + compensation_; }
+
+private:
+    double sum_ = 0.0;
+    double compensation_ = 0.0;
+};
+
+}  // namespace
+
+void BridgeCandidates::clear() {
+    radiusA.clear();
+    radiusB.clear();
+    centreDistance.clear();
+    wasBonded.clear();
+}
+
+void BridgeCandidates::reserve(std::size_t pairCount) {
+    radiusA.reserve(pairCount);
+    radiusB.reserve(pairCount);
+    centreDistance.reserve(pairCount);
+    wasBonded.reserve(pairCount);
+}
+
+void BridgeCandidates::add(double radiusOfA, double radiusOfB, double distanceOfCentres, bool bondedBefore) {
+    radiusA.push_back(radiusOfA);
+    radiusB.push_back(radiusOfB);
+    centreDistance.push_back(distanceOfCentres);
+    wasBonded.push_back(bondedBefore ? 1 : 0);
+}
+
+double waterVolumeFromContent(double waterContent, double drySolidMass, double waterDensity,
+                              const std::string& source) {
+    if (!(waterContent >= 0.0) || !std::isfinite(waterContent))
+        throw InputError(source + ": keyword 'waterContent' expects a finite mass ratio >= 0 (water/dry solid), got " +
+                         std::to_string(waterContent));
+    if (!(drySolidMass >= 0.0) || !std::isfinite(drySolidMass))
+        throw InputError(source + ": dry solid mass must be a finite number >= 0 [kg], got " +
+                         std::to_string(drySolidMass));
+    if (!(waterDensity > 0.0) || !std::isfinite(waterDensity))
+        throw InputError(source + ": keyword 'waterDensity' expects a finite number > 0 [kg/m^3], got " +
+                         std::to_string(waterDensity));
+    return waterContent * drySolidMass / waterDensity;
+}
+
+double liquidCoordinationNumber(std::size_t bondCount, std::size_t particleCount) {
+    if (particleCount == 0) return 0.0;
+    return 2.0 * static_cast<double>(bondCount) / static_cast<double>(particleCount);
+}
+
+double bridgeVolumeWeight(double radiusOfA, double radiusOfB, double distanceOfCentres, BridgeVolumeWeight weight) {
+    const double diameterA = 2.0 * radiusOfA;
+    const double diameterB = 2.0 * radiusOfB;
+    switch (weight) {
+        case BridgeVolumeWeight::DiameterProductTimesDistance:
+            return diameterA * diameterB * distanceOfCentres;
+        case BridgeVolumeWeight::DiameterSumTimesDistance:
+            return (diameterA + diameterB) * distanceOfCentres;
+    }
+    return 0.0;  // unreachable: every enumerator is handled above
+}
+
+LiquidBridgeNetwork::LiquidBridgeNetwork(double totalLiquidVolume, const LiquidBridgeSettings& settings)
+    : totalLiquid_(totalLiquidVolume), settings_(settings) {
+    if (!(totalLiquidVolume >= 0.0) || !std::isfinite(totalLiquidVolume))
+        throw InputError("liquid bridges: total liquid volume must be a finite number >= 0 [m^3], got " +
+                         std::to_string(totalLiquidVolume));
+    CapillaryParameters angleOnly;
+    angleOnly.contactAngle = settings.contactAngle;
+    validateCapillaryParameters(angleOnly, "liquid bridges");
+    distribution_.freeLiquid = totalLiquid_;  // nothing bonded before the first update
+}
+
+const BridgeDistribution& LiquidBridgeNetwork::update(const BridgeCandidates& candidates) {
+    const std::size_t pairCount = candidates.size();
+    if (candidates.radiusA.size() != pairCount || candidates.radiusB.size() != pairCount)
+        throw RuntimeError("liquid bridges: radius arrays and centre distances differ in length");
+    const bool persistent = settings_.formation == BridgeFormation::ContactThenPersist;
+    if (persistent && candidates.wasBonded.size() != pairCount)
+        throw RuntimeError("liquid bridges: ContactThenPersist needs one wasBonded flag per candidate pair");
+
+    distribution_.volume.assign(pairCount, 0.0);
+    distribution_.bonded.assign(pairCount, 0);
+    distribution_.bondCount = 0;
+    weight_.resize(pairCount);
+    stabilityThreshold_.resize(pairCount);
+    rankedPairs_.clear();
+
+    // λ*_k: the liquid per unit weight at which pair k's own bridge reaches its
+    // debonding distance, gap_k = (1+θ/2)(λ w_k)^(1/3).  Overlapping pairs: 0.
+    const double debondingPrefactor = 1.0 + 0.5 * settings_.contactAngle;
+    for (std::size_t k = 0; k < pairCount; ++k) {
+        const double ra = candidates.radiusA[k];
+        const double rb = candidates.radiusB[k];
+        const double distance = candidates.centreDistance[k];
+        if (!(ra > 0.0) || !(rb > 0.0) || !(distance > 0.0))
+            throw RuntimeError("liquid bridges: candidate pair " + std::to_string(k) +
+                               " has a non-positive radius or centre distance");
+        const double gap = distance - ra - rb;
+        if (persistent && gap > 0.0 && !candidates.wasBonded[k]) continue;  // no contact, no bridge yet
+        weight_[k] = bridgeVolumeWeight(ra, rb, distance, settings_.weight);
+        const double scaledGap = std::max(gap, 0.0) / debondingPrefactor;
+        stabilityThreshold_[k] = scaledGap * scaledGap * scaledGap / weight_[k];
+        rankedPairs_.push_back(k);
+    }
+
+    // Rank by stability (ties by index, so the result is deterministic).
+    std::sort(rankedPairs_.begin(), rankedPairs_.end(), [this](std::size_t a, std::size_t b) {
+        if (stabilityThreshold_[a] != stabilityThreshold_[b]) return stabilityThreshold_[a] < stabilityThreshold_[b];
+        return a < b;
+    });
+
+    // Accept whole groups of equal λ* while the group's own bridges stay stable
+    // with the liquid shared over everything accepted so far: λ* · W ≤ V.
+    // λ* rises and V/W falls along the ranking, so the stable prefixes are an
+    // initial run and the first failure ends the scan.
+    std::size_t acceptedCount = 0;
+    CompensatedSum acceptedWeight;
+    if (totalLiquid_ > 0.0) {
+        std::size_t groupBegin = 0;
+        while (groupBegin < rankedPairs_.size()) {
+            const double groupThreshold = stabilityThreshold_[rankedPairs_[groupBegin]];
+            std::size_t groupEnd = groupBegin;
+            CompensatedSum trialWeight = acceptedWeight;
+            while (groupEnd < rankedPairs_.size() && stabilityThreshold_[rankedPairs_[groupEnd]] == groupThreshold)
+                trialWeight.add(weight_[rankedPairs_[groupEnd++]]);
+            if (groupThreshold * trialWeight.value() > totalLiquid_) break;
+            acceptedWeight = trialWeight;
+            acceptedCount = groupEnd;
+            groupBegin = groupEnd;
+        }
+    }
+
+    CompensatedSum bondedLiquid;
+    const double liquidPerWeight = acceptedCount > 0 ? totalLiquid_ / acceptedWeight.value() : 0.0;
+    for (std::size_t rank = 0; rank < acceptedCount; ++rank) {
+        const std::size_t k = rankedPairs_[rank];
+        distribution_.volume[k] = liquidPerWeight * weight_[k];
+        distribution_.bonded[k] = 1;
+        bondedLiquid.add(distribution_.volume[k]);
+    }
+    distribution_.bondCount = acceptedCount;
+    distribution_.bondedLiquid = bondedLiquid.value();
+    distribution_.freeLiquid = acceptedCount > 0 ? 0.0 : totalLiquid_;
+    return distribution_;
+}
+
+}  // namespace dem

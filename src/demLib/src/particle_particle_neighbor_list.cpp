@@ -1,0 +1,235 @@
+#include "demLib/particle_particle_neighbor_list.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+namespace dem {
+
+namespace {
+
+int threadCount() {
+#ifdef _OPENMP
+    return omp_get_max_threads();
+#else
+    return 1;
+#endif
+}
+
+}  // namespace
+
+void ParticleParticleNeighborList::setRanges(double skin, double extraRange) {
+    skin_ = skin;
+    extraRange_ = extraRange;
+}
+
+bool ParticleParticleNeighborList::needsRebuild(const ParticleStore& particles) const {
+    if (positionAtBuild_.size() != particles.size()) return true;
+    const double limit2 = 0.25 * skin_ * skin_;
+    const std::size_t n = particles.size();
+    bool rebuild = false;
+#pragma omp parallel for schedule(static) reduction(|| : rebuild)
+    for (std::size_t i = 0; i < n; ++i)
+        if ((particles.position[i] - positionAtBuild_[i]).squaredNorm() > limit2) rebuild = true;
+    return rebuild;
+}
+
+void ParticleParticleNeighborList::build(const ParticleStore& particles) {
+    buildFrom(particles, particles.position);
+    positionAtBuild_ = particles.position;
+    ++buildCount_;
+}
+
+void ParticleParticleNeighborList::restore(const ParticleStore& particles,
+                                           const std::vector<Vec3>& positionAtBuild,
+                                           long buildCount) {
+    offsets_.assign(1, 0);
+    neighbors_.clear();
+    state_.clear();
+    buildFrom(particles, positionAtBuild);
+    positionAtBuild_ = positionAtBuild;
+    buildCount_ = buildCount;
+}
+
+bool ParticleParticleNeighborList::setState(int i, int j, const PairState& s) {
+    if (i > j) return false;
+    const auto first = neighbors_.begin() + offsets_[i];
+    const auto last = neighbors_.begin() + offsets_[i + 1];
+    const auto it = std::lower_bound(first, last, j);
+    if (it == last || *it != j) return false;
+    state_[it - neighbors_.begin()] = s;
+    return true;
+}
+
+void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
+                                             const std::vector<Vec3>& positions) {
+    const int n = static_cast<int>(particles.size());
+    std::vector<int> oldOffsets;
+    std::vector<int> oldNeighbors;
+    std::vector<PairState> oldState;
+    oldOffsets.swap(offsets_);
+    oldNeighbors.swap(neighbors_);
+    oldState.swap(state_);
+    // Particles appended since the last build (insertion) have no old pairs.
+    const int oldN = static_cast<int>(oldOffsets.size()) - 1;
+    const bool canTransfer = oldN >= 0 && oldN <= n;
+
+    offsets_.assign(n + 1, 0);
+    if (n == 0) return;
+
+    // Cell grid over the particles' bounding box, cells at least one interaction
+    // range wide so that only the 27 surrounding cells need a look.
+    Vec3 lo = positions[0], hi = positions[0];
+    double rMax = 0.0;
+    for (int i = 0; i < n; ++i) {
+        lo = lo.cwiseMin(positions[i]);
+        hi = hi.cwiseMax(positions[i]);
+        rMax = std::max(rMax, particles.radius[i]);
+    }
+    double cell = 2.0 * rMax + skin_ + extraRange_;
+    Vec3 extent = (hi - lo).cwiseMax(Vec3::Constant(cell));
+    // A scattered population (particles flying off) must not explode the grid.
+    const double maxCells = std::max(64.0, 4.0 * n);
+    while ((std::floor(extent.x() / cell) + 1) * (std::floor(extent.y() / cell) + 1) *
+               (std::floor(extent.z() / cell) + 1) > maxCells)
+        cell *= 1.26;
+    const int nx = static_cast<int>(extent.x() / cell) + 1;
+    const int ny = static_cast<int>(extent.y() / cell) + 1;
+    const int nz = static_cast<int>(extent.z() / cell) + 1;
+    const double invCell = 1.0 / cell;
+
+    std::vector<int> cellOf(n);
+    std::vector<int> cellStart(static_cast<std::size_t>(nx) * ny * nz + 1, 0);
+    for (int i = 0; i < n; ++i) {
+        const Vec3 r = (positions[i] - lo) * invCell;
+        const int cx = std::min(nx - 1, static_cast<int>(r.x()));
+        const int cy = std::min(ny - 1, static_cast<int>(r.y()));
+        const int cz = std::min(nz - 1, static_cast<int>(r.z()));
+        cellOf[i] = (cz * ny + cy) * nx + cx;
+        ++cellStart[cellOf[i] + 1];
+    }
+    for (std::size_t c = 1; c < cellStart.size(); ++c) cellStart[c] += cellStart[c - 1];
+    std::vector<int> cellParticles(n);
+    {
+        std::vector<int> fill(cellStart.begin(), cellStart.end() - 1);
+        for (int i = 0; i < n; ++i) cellParticles[fill[cellOf[i]]++] = i;  // ascending i per cell
+    }
+
+    // Each thread lists a contiguous block of i; blocks are joined in order, so
+    // the list does not depend on the thread count.
+    const int threads = threadCount();
+    std::vector<std::vector<int>> blockNeighbors(threads);
+    std::vector<int> count(n, 0);
+    const double reach = skin_ + extraRange_;
+#pragma omp parallel num_threads(threads)
+    {
+#ifdef _OPENMP
+        const int t = omp_get_thread_num();
+#else
+        const int t = 0;
+#endif
+        const int begin = static_cast<int>(static_cast<long>(n) * t / threads);
+        const int end = static_cast<int>(static_cast<long>(n) * (t + 1) / threads);
+        std::vector<int>& out = blockNeighbors[t];
+        out.reserve(static_cast<std::size_t>(end - begin) * 8);
+        std::vector<int> mine;
+        for (int i = begin; i < end; ++i) {
+            mine.clear();
+            const int c = cellOf[i];
+            const int cx = c % nx, cy = (c / nx) % ny, cz = c / (nx * ny);
+            const Vec3& xi = positions[i];
+            const double ri = particles.radius[i];
+            for (int dz = -1; dz <= 1; ++dz) {
+                const int z = cz + dz;
+                if (z < 0 || z >= nz) continue;
+                for (int dy = -1; dy <= 1; ++dy) {
+                    const int y = cy + dy;
+                    if (y < 0 || y >= ny) continue;
+                    for (int dx = -1; dx <= 1; ++dx) {
+                        const int x = cx + dx;
+                        if (x < 0 || x >= nx) continue;
+                        const int cc = (z * ny + y) * nx + x;
+                        for (int k = cellStart[cc]; k < cellStart[cc + 1]; ++k) {
+                            const int j = cellParticles[k];
+                            if (j <= i) continue;
+                            const double range = ri + particles.radius[j] + reach;
+                            if ((positions[j] - xi).squaredNorm() < range * range) mine.push_back(j);
+                        }
+                    }
+                }
+            }
+            std::sort(mine.begin(), mine.end());
+            count[i] = static_cast<int>(mine.size());
+            out.insert(out.end(), mine.begin(), mine.end());
+        }
+    }
+    for (int i = 0; i < n; ++i) offsets_[i + 1] = offsets_[i] + count[i];
+    neighbors_.reserve(offsets_[n]);
+    for (const auto& block : blockNeighbors) neighbors_.insert(neighbors_.end(), block.begin(), block.end());
+    state_.assign(neighbors_.size(), PairState{});
+
+    if (!canTransfer) return;
+    // Both lists are sorted by j within each i: merge to carry the pair state over.
+#pragma omp parallel for schedule(static)
+    for (int i = 0; i < oldN; ++i) {
+        int a = oldOffsets[i];
+        const int aEnd = oldOffsets[i + 1];
+        for (int b = offsets_[i]; b < offsets_[i + 1] && a < aEnd; ++b) {
+            while (a < aEnd && oldNeighbors[a] < neighbors_[b]) ++a;
+            if (a < aEnd && oldNeighbors[a] == neighbors_[b]) state_[b] = oldState[a];
+        }
+    }
+}
+
+void ParticleParticleNeighborList::remap(const std::vector<int>& oldToNew) {
+    const int oldN = static_cast<int>(offsets_.size()) - 1;
+    int newN = 0;
+    for (int k : oldToNew) newN = std::max(newN, k + 1);
+    struct Entry {
+        int i, j;
+        PairState s;
+    };
+    std::vector<Entry> entries;
+    for (int i = 0; i < oldN; ++i) {
+        for (int k = offsets_[i]; k < offsets_[i + 1]; ++k) {
+            const int a = oldToNew[i], b = oldToNew[neighbors_[k]];
+            if (a < 0 || b < 0) continue;
+            PairState s = state_[k];
+            if (a < b) {
+                entries.push_back({a, b, s});
+            } else {
+                // The pair is seen from the other particle now: history vectors,
+                // defined for the first particle of the pair, change sign.
+                s.contact.shear = -s.contact.shear;
+                s.contact.rollingTorque = -s.contact.rollingTorque;
+                entries.push_back({b, a, s});
+            }
+        }
+    }
+    std::sort(entries.begin(), entries.end(),
+              [](const Entry& x, const Entry& y) { return x.i != y.i ? x.i < y.i : x.j < y.j; });
+    offsets_.assign(newN + 1, 0);
+    neighbors_.resize(entries.size());
+    state_.resize(entries.size());
+    for (std::size_t k = 0; k < entries.size(); ++k) {
+        ++offsets_[entries[k].i + 1];
+        neighbors_[k] = entries[k].j;
+        state_[k] = entries[k].s;
+    }
+    for (int i = 0; i < newN; ++i) offsets_[i + 1] += offsets_[i];
+    std::vector<Vec3> moved(newN, Vec3::Zero());
+    for (int i = 0; i < oldN && i < static_cast<int>(positionAtBuild_.size()); ++i)
+        if (oldToNew[i] >= 0) moved[oldToNew[i]] = positionAtBuild_[i];
+    positionAtBuild_.swap(moved);
+}
+
+std::size_t ParticleParticleNeighborList::bytes() const {
+    return offsets_.capacity() * sizeof(int) + neighbors_.capacity() * sizeof(int) +
+           state_.capacity() * sizeof(PairState) + positionAtBuild_.capacity() * sizeof(Vec3);
+}
+
+}  // namespace dem

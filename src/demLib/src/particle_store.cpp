@@ -1,0 +1,109 @@
+#include "demLib/particle_store.hpp"
+
+#include <cmath>
+
+namespace dem {
+
+std::size_t ParticleStore::add(std::int64_t globalId, const Vec3& x, const Vec3& v, double r,
+                               double density, int materialIndex) {
+    const double m = density * 4.0 / 3.0 * M_PI * r * r * r;
+    id.push_back(globalId);
+    position.push_back(x);
+    velocity.push_back(v);
+    omega.push_back(Vec3::Zero());
+    force.push_back(Vec3::Zero());
+    torque.push_back(Vec3::Zero());
+    radius.push_back(r);
+    mass.push_back(m);
+    invMass.push_back(1.0 / m);
+    invInertia.push_back(1.0 / (0.4 * m * r * r));
+    material.push_back(materialIndex);
+    externalForce.push_back(Vec3::Zero());
+    return id.size() - 1;
+}
+
+namespace {
+template <class T>
+void keepIf(std::vector<T>& field, const std::vector<char>& keep) {
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < field.size(); ++i)
+        if (keep[i]) field[k++] = field[i];
+    field.resize(k);
+}
+
+template <class T>
+void reorder(std::vector<T>& field, const std::vector<int>& order) {
+    std::vector<T> out(order.size());
+    for (std::size_t k = 0; k < order.size(); ++k) out[k] = field[order[k]];
+    field.swap(out);
+}
+}  // namespace
+
+std::vector<int> ParticleStore::compact(const std::vector<char>& keep) {
+    std::vector<int> oldToNew(size(), -1);
+    int k = 0;
+    for (std::size_t i = 0; i < size(); ++i)
+        if (keep[i]) oldToNew[i] = k++;
+    keepIf(id, keep);
+    keepIf(position, keep);
+    keepIf(velocity, keep);
+    keepIf(omega, keep);
+    keepIf(force, keep);
+    keepIf(torque, keep);
+    keepIf(radius, keep);
+    keepIf(mass, keep);
+    keepIf(invMass, keep);
+    keepIf(invInertia, keep);
+    keepIf(material, keep);
+    keepIf(externalForce, keep);
+    return oldToNew;
+}
+
+void ParticleStore::permute(const std::vector<int>& order) {
+    reorder(id, order);
+    reorder(position, order);
+    reorder(velocity, order);
+    reorder(omega, order);
+    reorder(force, order);
+    reorder(torque, order);
+    reorder(radius, order);
+    reorder(mass, order);
+    reorder(invMass, order);
+    reorder(invInertia, order);
+    reorder(material, order);
+    reorder(externalForce, order);
+}
+
+void ParticleStore::reserve(std::size_t n) {
+    id.reserve(n);
+    position.reserve(n);
+    velocity.reserve(n);
+    omega.reserve(n);
+    force.reserve(n);
+    torque.reserve(n);
+    radius.reserve(n);
+    mass.reserve(n);
+    invMass.reserve(n);
+    invInertia.reserve(n);
+    material.reserve(n);
+    externalForce.reserve(n);
+}
+
+double ParticleStore::totalMass() const {
+    double m = 0.0;
+    for (double mi : mass) m += mi;
+    return m;
+}
+
+double ParticleStore::kineticEnergy() const {
+    double e = 0.0;
+    for (std::size_t i = 0; i < size(); ++i)
+        e += 0.5 * mass[i] * velocity[i].squaredNorm() + 0.5 / invInertia[i] * omega[i].squaredNorm();
+    return e;
+}
+
+std::size_t ParticleStore::bytesPerParticle() const {
+    return sizeof(std::int64_t) + 5 * sizeof(Vec3) + 4 * sizeof(double) + sizeof(int);
+}
+
+}  // namespace dem

@@ -1,0 +1,235 @@
+#include "demLib/simulation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "demLib/error.hpp"
+#include "demLib/integrator.hpp"
+
+namespace dem {
+
+namespace {
+
+std::string formatVec(const Vec3& v) {
+    std::ostringstream s;
+    s.precision(6);
+    s << "(" << v.x() << " " << v.y() << " " << v.z() << ")";
+    return s.str();
+}
+
+}  // namespace
+
+Simulation::Simulation(SimulationSettings settings, std::vector<Material> materials,
+                       InteractionTable interactions, std::vector<Wall> walls)
+    : settings_(std::move(settings)),
+      materials_(std::move(materials)),
+      interactions_(std::move(interactions)),
+      walls_(std::move(walls)) {
+    const std::string& src = settings_.source;
+    if (!(settings_.timeStep > 0.0) || !std::isfinite(settings_.timeStep))
+        throw InputError(src + ": keyword 'timeStep' expects a positive number of seconds");
+    if (!(settings_.skinFraction > 0.0))
+        throw InputError(src + ": keyword 'skinFraction' expects a positive fraction of the largest diameter");
+    if (!(settings_.maxRayleighFraction > 0.0))
+        throw InputError(src + ": keyword 'maxRayleighFraction' expects a positive number");
+    if (materials_.empty()) throw InputError(src + ": no material defined; expected at least one in 'materials'");
+    for (const Material& m : materials_) validateMaterial(m);
+    interactions_.requireComplete(materials_);
+    for (const Wall& w : walls_)
+        if (w.materialIndex < 0 || w.materialIndex >= static_cast<int>(materials_.size()))
+            throw InputError(src + ": wall '" + w.name + "' has no valid material");
+    if (settings_.forces.cohesion == CohesionModel::Capillary)
+        validateCapillaryParameters(settings_.forces.capillary, src);
+    kernel_ = makeContactForceKernel(settings_.forces);
+}
+
+void Simulation::insert(const std::vector<InsertedParticle>& inserted, int materialIndex, const Vec3& velocity,
+                        const std::string& context) {
+    if (materialIndex < 0 || materialIndex >= static_cast<int>(materials_.size()))
+        throw InputError(context + ": material index " + std::to_string(materialIndex) + " out of range");
+    std::vector<WallContact> touching;
+    for (std::size_t k = 0; k < inserted.size(); ++k) {
+        const InsertedParticle& q = inserted[k];
+        if (!(q.radius > 0.0) || !std::isfinite(q.radius))
+            throw InputError(context + ": particle " + std::to_string(k) + " has radius " +
+                             std::to_string(q.radius) + "; expected a positive radius");
+        if (!q.position.allFinite())
+            throw InputError(context + ": particle " + std::to_string(k) + " has a non-finite position");
+        for (const Wall& w : walls_) {
+            if (!w.isActive(time_)) continue;
+            touching.clear();
+            w.findContacts(q.position, q.radius, time_, touching);
+            for (const WallContact& c : touching) {
+                // A particle placed inside a wall would be shot out by a huge force.
+                if (c.overlap > 1e-6 * q.radius)
+                    throw InputError(context + ": particle " + std::to_string(k) + " at " + formatVec(q.position) +
+                                     " (radius " + std::to_string(q.radius) + ") overlaps wall '" + w.name +
+                                     "' by " + std::to_string(c.overlap) +
+                                     " m; expected every particle clear of the walls");
+            }
+        }
+    }
+    const double density = materials_[materialIndex].density;
+    particles_.reserve(particles_.size() + inserted.size());
+    for (const InsertedParticle& q : inserted)
+        particles_.add(nextId_++, q.position, velocity, q.radius, density, materialIndex);
+    checkTimeStep(context);
+    forcesValid_ = false;
+}
+
+double Simulation::maxAllowedTimeStep() const {
+    double smallest = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < particles_.size(); ++i) {
+        const Material& m = materials_[particles_.material[i]];
+        smallest = std::min(smallest, criticalTimeStep(m, particles_.radius[i]));
+    }
+    return settings_.maxRayleighFraction * smallest;
+}
+
+void Simulation::checkTimeStep(const std::string& context) const {
+    const double allowed = maxAllowedTimeStep();
+    if (settings_.timeStep > allowed && !settings_.allowLargeTimeStep) {
+        std::ostringstream s;
+        s << settings_.source << ": keyword 'timeStep' = " << settings_.timeStep << " s is larger than "
+          << settings_.maxRayleighFraction << " x the Rayleigh time of the smallest particle (" << allowed
+          << " s allowed) after " << context
+          << "; expected timeStep <= " << allowed
+          << " (or set 'allowLargeTimeStep true' to override, at your own risk)";
+        throw InputError(s.str());
+    }
+}
+
+void Simulation::setWaterContent(double w) {
+    const double volume = waterVolumeFromContent(w, particles_.totalMass(), 1000.0, settings_.source);
+    liquid_.waterContent = w;
+    liquid_.totalVolume = volume;
+    liquidNetwork_ = std::make_unique<LiquidBridgeNetwork>(volume, settings_.bridges);
+    largestBridge_ = 0.0;
+    forcesValid_ = false;
+}
+
+double Simulation::liquidInBridges() const {
+    double sum = 0.0, carry = 0.0;  // Kahan: the conservation check is to 1e-12
+    for (const PairState& s : pairs_.state()) {
+        const double y = s.bridgeVolume - carry;
+        const double t = sum + y;
+        carry = (t - sum) - y;
+        sum = t;
+    }
+    return sum;
+}
+
+double Simulation::liquidCoordinationNumber() const {
+    return particles_.empty() ? 0.0 : 2.0 * static_cast<double>(liquid_.bridgeCount) / particles_.size();
+}
+
+double Simulation::coordinationNumber() const {
+    return particles_.empty() ? 0.0 : 2.0 * static_cast<double>(last_.contacts.touchingPairs) / particles_.size();
+}
+
+void Simulation::removeLostParticles() {
+    last_.lostThisStep = 0;
+    if (!settings_.domain) return;
+    const std::size_t n = particles_.size();
+    std::vector<char> keep(n, 1);
+    std::size_t out = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        if (!settings_.domain->contains(particles_.position[i]) || !particles_.position[i].allFinite()) {
+            keep[i] = 0;
+            ++out;
+            lostMass_ += particles_.mass[i];
+        }
+    }
+    if (out == 0) return;
+    // Liquid held by bridges of lost particles returns to the pool: the water
+    // budget stays closed and is redistributed over the remaining bridges.
+    if (liquidNetwork_) {
+        const auto& offsets = pairs_.offsets();
+        const auto& neighbors = pairs_.neighbors();
+        for (std::size_t i = 0; i + 1 < offsets.size(); ++i)
+            for (int k = offsets[i]; k < offsets[i + 1]; ++k)
+                if (!keep[i] || !keep[neighbors[k]]) liquid_.poolVolume += pairs_.state()[k].bridgeVolume;
+    }
+    const std::vector<int> oldToNew = particles_.compact(keep);
+    pairs_.remap(oldToNew);
+    wallContacts_.remap(oldToNew);
+    lost_ += out;
+    last_.lostThisStep = out;
+}
+
+void Simulation::updatePairList() {
+    double rMax = 0.0;
+    for (double r : particles_.radius) rMax = std::max(rMax, r);
+    double extra = 0.0;
+    if (liquidNetwork_ && !particles_.empty()) {
+        // Bridges can only form between listed pairs: reach out to the debonding
+        // distance of a bridge larger than any seen so far (and at least of the
+        // liquid of one particle, which bounds a bridge at the first update).
+        const double perParticle = liquid_.totalVolume / particles_.size();
+        extra = debondingDistance(std::max(1.5 * largestBridge_, perParticle), settings_.bridges.contactAngle);
+    }
+    pairs_.setRanges(settings_.skinFraction * 2.0 * rMax, extra);
+    pairs_.build(particles_);
+    if (liquidNetwork_) redistributeLiquid();
+}
+
+void Simulation::redistributeLiquid() {
+    BridgeCandidates candidates;
+    const auto& offsets = pairs_.offsets();
+    const auto& neighbors = pairs_.neighbors();
+    auto& state = pairs_.state();
+    candidates.reserve(neighbors.size());
+    for (std::size_t i = 0; i + 1 < offsets.size(); ++i)
+        for (int k = offsets[i]; k < offsets[i + 1]; ++k) {
+            const int j = neighbors[k];
+            candidates.add(particles_.radius[i], particles_.radius[j],
+                           (particles_.position[i] - particles_.position[j]).norm(), state[k].bridgeVolume > 0.0);
+        }
+    const BridgeDistribution& d = liquidNetwork_->update(candidates);
+    largestBridge_ = 0.0;
+    for (std::size_t k = 0; k < state.size(); ++k) {
+        state[k].bridgeVolume = d.volume[k];
+        largestBridge_ = std::max(largestBridge_, d.volume[k]);
+    }
+    liquid_.poolVolume = d.freeLiquid;
+    liquid_.bridgeCount = d.bondCount;
+}
+
+void Simulation::computeForces() {
+    const std::size_t n = particles_.size();
+    const Vec3 g = settings_.gravity;
+#pragma omp parallel for schedule(static)
+    for (std::size_t i = 0; i < n; ++i) {
+        particles_.force[i] = particles_.mass[i] * g + particles_.externalForce[i];
+        particles_.torque[i].setZero();
+    }
+    last_.contacts = kernel_->compute(particles_, pairs_, wallContacts_, walls_, interactions_, time_,
+                                      settings_.timeStep);
+    if (liquidNetwork_) {
+        liquid_.poolVolume += last_.contacts.releasedLiquid;
+        liquid_.bridgeCount = last_.contacts.bridges;
+    }
+}
+
+void Simulation::step(long steps) {
+    const double dt = settings_.timeStep;
+    for (long s = 0; s < steps; ++s) {
+        if (!forcesValid_) {
+            updatePairList();
+            computeForces();
+            forcesValid_ = true;
+        }
+        kickAndDrift(particles_, dt);
+        ++step_;
+        // Time from the step count: no drift from summing dt, exact on restart.
+        time_ = step_ * dt;
+        removeLostParticles();
+        if (last_.lostThisStep > 0 || pairs_.needsRebuild(particles_)) updatePairList();
+        computeForces();
+        kick(particles_, dt);
+    }
+}
+
+}  // namespace dem

@@ -1,0 +1,203 @@
+// Restart files: the whole state of a Simulation, contact history included, so
+// that a continued run is bitwise identical to an uninterrupted one (same
+// thread count).  Written to a temporary name and renamed, so an interrupted
+// write never corrupts the previous restart file.
+#include <algorithm>
+#include <cstdio>
+#include <unordered_map>
+
+#include "demLib/error.hpp"
+#include "demLib/hdf5_file.hpp"
+#include "demLib/simulation.hpp"
+
+namespace dem {
+
+namespace {
+constexpr const char* restartFormat = "diefill-demLib-restart-1";
+}
+
+void Simulation::writeRestart(const std::string& path) const {
+    const std::string tmp = path + ".writing";
+    {
+        Hdf5File f(tmp, Hdf5File::Mode::Create);
+        f.setAttribute("format", std::string(restartFormat));
+        f.setAttribute("time", time_);
+        f.setAttribute("step", static_cast<std::int64_t>(step_));
+        f.setAttribute("timeStep", settings_.timeStep);
+        f.setAttribute("nextId", static_cast<std::int64_t>(nextId_));
+        f.setAttribute("lostCount", static_cast<std::int64_t>(lost_));
+        f.setAttribute("lostMass", lostMass_);
+        f.setAttribute("forcesValid", static_cast<std::int64_t>(forcesValid_));
+        f.setAttribute("materialCount", static_cast<std::int64_t>(materials_.size()));
+        f.setAttribute("wallCount", static_cast<std::int64_t>(walls_.size()));
+        f.setAttribute("liquidTotal", liquid_.totalVolume);
+        f.setAttribute("liquidPool", liquid_.poolVolume);
+        f.setAttribute("waterContent", liquid_.waterContent);
+        f.setAttribute("bridgeCount", static_cast<std::int64_t>(liquid_.bridgeCount));
+        f.setAttribute("hasLiquid", static_cast<std::int64_t>(liquidNetwork_ != nullptr));
+        f.setAttribute("largestBridge", largestBridge_);
+        f.setAttribute("listSkin", pairs_.skin());
+        f.setAttribute("listExtraRange", pairs_.extraRange());
+        f.setAttribute("listBuildCount", static_cast<std::int64_t>(pairs_.buildCount()));
+
+        const ParticleStore& p = particles_;
+        f.createGroup("particles");
+        f.write("particles/id", p.id);
+        f.write("particles/position", p.position);
+        f.write("particles/velocity", p.velocity);
+        f.write("particles/omega", p.omega);
+        f.write("particles/force", p.force);
+        f.write("particles/torque", p.torque);
+        f.write("particles/externalForce", p.externalForce);
+        f.write("particles/radius", p.radius);
+        f.write("particles/mass", p.mass);
+        f.write("particles/material", p.material);
+        f.write("particles/positionAtListBuild", pairs_.positionsAtBuild());
+
+        // Pair state by global ids, only where there is something to remember.
+        std::vector<std::int64_t> ids;
+        std::vector<Vec3> shear, rolling;
+        std::vector<double> bridge;
+        const auto& offsets = pairs_.offsets();
+        const auto& neighbors = pairs_.neighbors();
+        const auto& state = pairs_.state();
+        for (std::size_t i = 0; i + 1 < offsets.size(); ++i)
+            for (int k = offsets[i]; k < offsets[i + 1]; ++k) {
+                const PairState& s = state[k];
+                if (s.bridgeVolume == 0.0 && s.contact.shear.isZero(0.0) && s.contact.rollingTorque.isZero(0.0))
+                    continue;
+                ids.push_back(p.id[i]);
+                ids.push_back(p.id[neighbors[k]]);
+                shear.push_back(s.contact.shear);
+                rolling.push_back(s.contact.rollingTorque);
+                bridge.push_back(s.bridgeVolume);
+            }
+        f.createGroup("pairs");
+        f.write("pairs/ids", ids, 2);
+        f.write("pairs/shear", shear);
+        f.write("pairs/rollingTorque", rolling);
+        f.write("pairs/bridgeVolume", bridge);
+
+        std::vector<std::int64_t> wallKeys;
+        std::vector<Vec3> wShear, wRolling;
+        std::vector<double> wBridge;
+        for (const WallContactRecord& r : wallContacts_.records()) {
+            wallKeys.push_back(p.id[r.particle]);
+            wallKeys.push_back(r.wall);
+            wallKeys.push_back(r.feature);
+            wShear.push_back(r.history.shear);
+            wRolling.push_back(r.history.rollingTorque);
+            wBridge.push_back(r.bridgeVolume);
+        }
+        f.createGroup("wallContacts");
+        f.write("wallContacts/keys", wallKeys, 3);
+        f.write("wallContacts/shear", wShear);
+        f.write("wallContacts/rollingTorque", wRolling);
+        f.write("wallContacts/bridgeVolume", wBridge);
+    }
+    if (std::rename(tmp.c_str(), path.c_str()) != 0)
+        throw RuntimeError("cannot rename restart file '" + tmp + "' to '" + path + "'");
+}
+
+void Simulation::readRestart(const std::string& path) {
+    Hdf5File f(path, Hdf5File::Mode::Read);
+    const std::string format = f.stringAttribute("format");
+    if (format != restartFormat)
+        throw InputError("restart file '" + path + "': format '" + format + "', expected '" + restartFormat + "'");
+    if (f.intAttribute("materialCount") != static_cast<std::int64_t>(materials_.size()) ||
+        f.intAttribute("wallCount") != static_cast<std::int64_t>(walls_.size()))
+        throw InputError("restart file '" + path + "' was written for " +
+                         std::to_string(f.intAttribute("materialCount")) + " materials and " +
+                         std::to_string(f.intAttribute("wallCount")) + " walls; the case defines " +
+                         std::to_string(materials_.size()) + " and " + std::to_string(walls_.size()));
+    if (f.doubleAttribute("timeStep") != settings_.timeStep)
+        throw InputError("restart file '" + path + "' was written with timeStep " +
+                         std::to_string(f.doubleAttribute("timeStep")) + "; the case now says " +
+                         std::to_string(settings_.timeStep) + " (continue with the same time step)");
+
+    ParticleStore p;
+    p.id = f.readInt64("particles/id");
+    p.position = f.readVec3("particles/position");
+    p.velocity = f.readVec3("particles/velocity");
+    p.omega = f.readVec3("particles/omega");
+    p.force = f.readVec3("particles/force");
+    p.torque = f.readVec3("particles/torque");
+    p.externalForce = f.readVec3("particles/externalForce");
+    p.radius = f.readDoubles("particles/radius");
+    p.mass = f.readDoubles("particles/mass");
+    p.material = f.readInts("particles/material");
+    const std::size_t n = p.id.size();
+    if (p.position.size() != n || p.radius.size() != n || p.mass.size() != n || p.material.size() != n)
+        throw InputError("restart file '" + path + "': particle datasets have different lengths");
+    p.invMass.resize(n);
+    p.invInertia.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        p.invMass[i] = 1.0 / p.mass[i];
+        p.invInertia[i] = 1.0 / (0.4 * p.mass[i] * p.radius[i] * p.radius[i]);
+        if (p.material[i] < 0 || p.material[i] >= static_cast<int>(materials_.size()))
+            throw InputError("restart file '" + path + "': particle material index out of range");
+    }
+    particles_ = std::move(p);
+
+    time_ = f.doubleAttribute("time");
+    step_ = f.intAttribute("step");
+    nextId_ = f.intAttribute("nextId");
+    lost_ = f.intAttribute("lostCount");
+    lostMass_ = f.doubleAttribute("lostMass");
+    forcesValid_ = f.intAttribute("forcesValid") != 0;
+    liquid_.totalVolume = f.doubleAttribute("liquidTotal");
+    liquid_.poolVolume = f.doubleAttribute("liquidPool");
+    liquid_.waterContent = f.doubleAttribute("waterContent");
+    liquid_.bridgeCount = f.intAttribute("bridgeCount");
+    largestBridge_ = f.doubleAttribute("largestBridge");
+    liquidNetwork_.reset();
+    if (f.intAttribute("hasLiquid"))
+        liquidNetwork_ = std::make_unique<LiquidBridgeNetwork>(liquid_.totalVolume, settings_.bridges);
+
+    std::unordered_map<std::int64_t, int> indexOf;
+    indexOf.reserve(n);
+    for (std::size_t i = 0; i < n; ++i) indexOf[particles_.id[i]] = static_cast<int>(i);
+    auto lookup = [&](std::int64_t id) {
+        const auto it = indexOf.find(id);
+        if (it == indexOf.end())
+            throw InputError("restart file '" + path + "': contact refers to unknown particle id " +
+                             std::to_string(id));
+        return it->second;
+    };
+
+    pairs_.setRanges(f.doubleAttribute("listSkin"), f.doubleAttribute("listExtraRange"));
+    pairs_.restore(particles_, f.readVec3("particles/positionAtListBuild"), f.intAttribute("listBuildCount"));
+    const auto ids = f.readInt64("pairs/ids");
+    const auto shear = f.readVec3("pairs/shear");
+    const auto rolling = f.readVec3("pairs/rollingTorque");
+    const auto bridge = f.readDoubles("pairs/bridgeVolume");
+    for (std::size_t k = 0; k < shear.size(); ++k) {
+        PairState s;
+        s.contact.shear = shear[k];
+        s.contact.rollingTorque = rolling[k];
+        s.bridgeVolume = bridge[k];
+        if (!pairs_.setState(lookup(ids[2 * k]), lookup(ids[2 * k + 1]), s))
+            throw InputError("restart file '" + path + "': saved pair (" + std::to_string(ids[2 * k]) + ", " +
+                             std::to_string(ids[2 * k + 1]) + ") is not in the rebuilt neighbour list");
+    }
+
+    auto& records = wallContacts_.records();
+    records.clear();
+    const auto keys = f.readInt64("wallContacts/keys");
+    const auto wShear = f.readVec3("wallContacts/shear");
+    const auto wRolling = f.readVec3("wallContacts/rollingTorque");
+    const auto wBridge = f.readDoubles("wallContacts/bridgeVolume");
+    for (std::size_t k = 0; k < wShear.size(); ++k) {
+        WallContactRecord r;
+        r.particle = lookup(keys[3 * k]);
+        r.wall = static_cast<int>(keys[3 * k + 1]);
+        r.feature = static_cast<int>(keys[3 * k + 2]);
+        r.history.shear = wShear[k];
+        r.history.rollingTorque = wRolling[k];
+        r.bridgeVolume = wBridge[k];
+        records.push_back(r);
+    }
+    std::sort(records.begin(), records.end());
+}
+
+}  // namespace dem

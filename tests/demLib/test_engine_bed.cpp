@@ -1,0 +1,372 @@
+// Verification of dem::Simulation on many-particle cases: a poured
+// polydisperse bed (settling, containment, packing fraction), bitwise
+// reproducibility and restart continuation, and a Lethe-style regression
+// against a committed reference file.
+//
+// Regression reference: tests/demLib/data/regression/settle_reference.txt.
+// After a deliberate change of the physics or of the order of floating-point
+// operations, regenerate it with
+//     DEMLIB_REGENERATE_REFERENCE=1 build/enginetests/tests/test_engine_bed \
+//         --gtest_filter='EngineRegression.*'
+// and commit the new file together with the change that explains it.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "demLib/insertion.hpp"
+#include "demLib/simulation.hpp"
+#include "demLib/size_distribution.hpp"
+
+namespace {
+
+using dem::Vec3;
+
+constexpr double kPi = 3.14159265358979323846;
+
+dem::Material glass() { return {"glass", 5e6, 0.3, 2500.0}; }
+dem::Material steel() { return {"steel", 2e7, 0.3, 7800.0}; }
+
+// The tests that change the thread count put it back.
+class ThreadCount {
+public:
+    explicit ThreadCount(int n) {
+#ifdef _OPENMP
+        saved_ = omp_get_max_threads();
+        omp_set_num_threads(n);
+#else
+        (void)n;
+#endif
+    }
+    ~ThreadCount() {
+#ifdef _OPENMP
+        omp_set_num_threads(saved_);
+#endif
+    }
+
+private:
+    int saved_ = 1;
+};
+
+// A closed box [0, W] x [0, W] x [0, H] of six one-sided planes (steel), the
+// particles glass.  floorVelocity != 0 makes the floor slide in its own plane.
+struct BoxCase {
+    double width = 0.012;
+    double height = 0.03;
+    std::size_t count = 500;
+    double dMin = 1.0e-3;
+    double dMax = 2.0e-3;
+    double dt = 1e-5;
+    dem::RollingModel rolling = dem::RollingModel::EPSD2;
+    double rollingFriction = 0.1;
+    Vec3 floorVelocity = Vec3::Zero();
+    std::uint64_t seed = 11;
+};
+
+dem::SimulationSettings settingsFor(const BoxCase& c) {
+    dem::SimulationSettings s;
+    s.timeStep = c.dt;
+    s.gravity = Vec3(0, 0, -9.81);
+    s.forces.rolling = c.rolling;
+    s.domain = dem::AxisAlignedBox{Vec3(-0.001, -0.001, -0.001),
+                                   Vec3(c.width + 0.001, c.width + 0.001, c.height + 0.001)};
+    s.source = "test_engine_bed";
+    return s;
+}
+
+dem::Simulation makeBox(const BoxCase& c) {
+    const std::vector<dem::Material> mats{glass(), steel()};
+    dem::InteractionTable table(2);
+    dem::PairCoefficients particleParticle;
+    particleParticle.restitution = 0.5;
+    particleParticle.friction = 0.5;
+    particleParticle.rollingFriction = c.rollingFriction;
+    dem::PairCoefficients particleWall = particleParticle;
+    particleWall.friction = 0.61;
+    table.set(mats, 0, 0, particleParticle);
+    table.set(mats, 0, 1, particleWall);
+    table.set(mats, 1, 1, particleWall);
+
+    const double W = c.width, H = c.height;
+    dem::WallMotion floorMotion;
+    if (c.floorVelocity.squaredNorm() > 0.0) floorMotion.addTranslation(0.0, 100.0, c.floorVelocity);
+    std::vector<dem::Wall> walls{
+        {"floor", dem::PlaneWall(Vec3(0, 0, 0), Vec3::UnitZ()), floorMotion, 1},
+        {"lid", dem::PlaneWall(Vec3(0, 0, H), -Vec3::UnitZ()), {}, 1},
+        {"xMin", dem::PlaneWall(Vec3(0, 0, 0), Vec3::UnitX()), {}, 1},
+        {"xMax", dem::PlaneWall(Vec3(W, 0, 0), -Vec3::UnitX()), {}, 1},
+        {"yMin", dem::PlaneWall(Vec3(0, 0, 0), Vec3::UnitY()), {}, 1},
+        {"yMax", dem::PlaneWall(Vec3(0, W, 0), -Vec3::UnitY()), {}, 1}};
+    dem::Simulation sim(settingsFor(c), mats, table, walls);
+
+    const dem::SizeDistribution psd = dem::SizeDistribution::fromPercentages(
+        {{c.dMin, 0.5 * (c.dMin + c.dMax), 50.0}, {0.5 * (c.dMin + c.dMax), c.dMax, 50.0}});
+    dem::InsertionRequest request;
+    request.targetCount = c.count;
+    request.density = glass().density;
+    request.placement.seed = c.seed;
+    request.placement.gapFraction = 0.05;
+    request.placement.settleDirection = Vec3(0, 0, -1);
+    sim.insert(dem::insertParticles(dem::Region::box(Vec3::Zero(), Vec3(W, W, H)), psd, request), 0,
+               Vec3::Zero(), "bed insertion");
+    return sim;
+}
+
+double potentialEnergy(const dem::ParticleStore& p) {
+    double u = 0.0;
+    for (std::size_t i = 0; i < p.size(); ++i) u += p.mass[i] * 9.81 * p.position[i].z();
+    return u;
+}
+
+// ---------------------------------------------------------------------------
+// 5. A poured bed.  500 spheres of 1-2 mm (half the mass in each half of the
+// range) fall from a loose lattice into a 12 mm box and settle.
+//
+// Packing: random packings of frictional spheres (mu = 0.5) lie between
+// random loose packing (~0.55) and random close packing (~0.64; a little
+// higher for polydisperse mixtures, but the 1:2 range here changes it by
+// < 0.01).  The solid fraction is sampled on a grid of points in the core of
+// the bed, one largest diameter away from the side walls and the floor and two
+// below the surface, where the wall ordering does not reach.
+//
+// Height: the bed height predicted from that solid fraction,
+// H = V_solid / (A phi_core), is compared with the measured surface height
+// (where the cross-section solid fraction falls to half the core value).
+// The measured bed is a little taller because the layer at the walls packs
+// looser than the core; the tolerance is 8 %.
+
+// Fraction of grid points in [lo, hi] that lie inside some sphere.
+double solidFraction(const dem::ParticleStore& p, const Vec3& lo, const Vec3& hi, int n) {
+    long inside = 0, total = 0;
+    for (int a = 0; a < n; ++a)
+        for (int b = 0; b < n; ++b)
+            for (int c = 0; c < n; ++c) {
+                const Vec3 x = lo + Vec3((a + 0.5) / n, (b + 0.5) / n, (c + 0.5) / n).cwiseProduct(hi - lo);
+                ++total;
+                for (std::size_t i = 0; i < p.size(); ++i)
+                    if ((p.position[i] - x).squaredNorm() < p.radius[i] * p.radius[i]) {
+                        ++inside;
+                        break;
+                    }
+            }
+    return static_cast<double>(inside) / total;
+}
+
+TEST(EngineBed, PouredBedSettlesInsideTheBoxWithSoundPacking) {
+    ThreadCount threads(1);
+    BoxCase c;
+    dem::Simulation sim = makeBox(c);
+    const auto& p = sim.particles();
+    ASSERT_EQ(p.size(), c.count);
+    const double u0 = potentialEnergy(p);
+    double kineticOverDrop = 1.0;
+    double maxKinetic = 0.0;
+    while (sim.time() < 1.0) {
+        sim.step(2000);
+        maxKinetic = std::max(maxKinetic, p.kineticEnergy());
+        kineticOverDrop = p.kineticEnergy() / (u0 - potentialEnergy(p));
+        if (sim.time() > 0.2 && kineticOverDrop < 1e-6) break;
+    }
+    const double drop = u0 - potentialEnergy(p);
+    std::printf("bed: settled at t = %.3f s, KE / potential drop = %.3e (peak KE / drop %.3e)\n", sim.time(),
+                kineticOverDrop, maxKinetic / drop);
+    EXPECT_LT(kineticOverDrop, 1e-6);
+    EXPECT_GT(maxKinetic / drop, 0.05);  // it really fell
+    EXPECT_EQ(sim.lostCount(), 0u);
+    EXPECT_EQ(p.size(), c.count);
+
+    double solidVolume = 0.0, top = 0.0, maxOverlapRatio = 0.0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        const Vec3& x = p.position[i];
+        const double r = p.radius[i];
+        solidVolume += 4.0 / 3.0 * kPi * r * r * r;
+        top = std::max(top, x.z() + r);
+        // Inside the box: a centre may be at most a small Hertz overlap outside r.
+        for (int k = 0; k < 3; ++k) {
+            const double extent = k == 2 ? c.height : c.width;
+            EXPECT_GT(x[k], 0.99 * r) << "particle " << i;
+            EXPECT_LT(x[k], extent - 0.99 * r) << "particle " << i;
+        }
+        for (std::size_t j = i + 1; j < p.size(); ++j) {
+            const double overlap = r + p.radius[j] - (x - p.position[j]).norm();
+            maxOverlapRatio = std::max(maxOverlapRatio, overlap / std::min(r, p.radius[j]));
+        }
+    }
+    // Under ~10 layers of weight the Hertz overlaps stay small (soft E = 5 MPa).
+    EXPECT_LT(maxOverlapRatio, 0.02);
+
+    // Surface height: where the solid fraction of a thin full-width slice falls
+    // below half of the core value.
+    const double m = c.dMax;
+    const double coreTop = top - 2.0 * m;
+    ASSERT_GT(coreTop, 2.0 * m);
+    const double phiCore =
+        solidFraction(p, Vec3(m, m, m), Vec3(c.width - m, c.width - m, coreTop), 40);
+    double surface = 0.0;
+    for (double z = 0.0; z < top; z += 0.05 * m) {
+        const double phiSlice = solidFraction(p, Vec3(0, 0, z), Vec3(c.width, c.width, z + 0.05 * m), 30);
+        if (phiSlice >= 0.5 * phiCore) surface = z + 0.025 * m;
+    }
+    const double predicted = solidVolume / (c.width * c.width * phiCore);
+    std::printf("bed: phi_core = %.4f, surface %.3f mm, predicted %.3f mm (ratio %.4f), max overlap/r %.4f\n",
+                phiCore, 1e3 * surface, 1e3 * predicted, surface / predicted, maxOverlapRatio);
+    EXPECT_GT(phiCore, 0.55);
+    EXPECT_LT(phiCore, 0.64);
+    EXPECT_NEAR(surface / predicted, 1.0, 0.08);
+}
+
+// ---------------------------------------------------------------------------
+// 6. Reproducibility and restart.  A smaller box whose floor slides in its own
+// plane (a moving wall with sustained, sliding contacts), EPSD2 rolling
+// history, particles resting on each other.
+
+struct State {
+    std::vector<Vec3> position, velocity, omega;
+};
+
+State stateOf(const dem::Simulation& sim) {
+    return {sim.particles().position, sim.particles().velocity, sim.particles().omega};
+}
+
+void expectBitwiseEqual(const State& a, const State& b, const std::string& what) {
+    ASSERT_EQ(a.position.size(), b.position.size()) << what;
+    std::size_t differing = 0;
+    for (std::size_t i = 0; i < a.position.size(); ++i)
+        if (!(a.position[i] == b.position[i]) || !(a.velocity[i] == b.velocity[i]) || !(a.omega[i] == b.omega[i]))
+            ++differing;
+    EXPECT_EQ(differing, 0u) << what << ": particles that differ";
+}
+
+BoxCase restartCase() {
+    BoxCase c;
+    c.width = 0.008;
+    c.height = 0.02;
+    c.count = 150;
+    c.floorVelocity = Vec3(0.02, 0.0, 0.0);
+    c.seed = 5;
+    return c;
+}
+
+constexpr long kStepsBefore = 8000;  // fall and land: contacts everywhere at the restart
+constexpr long kStepsAfter = 3000;
+
+void checkRepeatAndRestart(int threadCount) {
+    ThreadCount threads(threadCount);
+    const BoxCase c = restartCase();
+    const std::string path = ::testing::TempDir() + "engine_restart_" + std::to_string(threadCount) + ".h5";
+
+    dem::Simulation first = makeBox(c);
+    first.step(kStepsBefore);
+    // The restart point must be a hard one: touching pairs, wall contacts on
+    // the moving floor, non-zero rolling and tangential history.
+    EXPECT_GT(first.lastStep().contacts.touchingPairs, c.count / 2);
+    EXPECT_GT(first.lastStep().contacts.wallContacts, 10u);
+    double rollingHistory = 0.0, shearHistory = 0.0;
+    for (const dem::PairState& s : first.pairList().state()) {
+        rollingHistory = std::max(rollingHistory, s.contact.rollingTorque.norm());
+        shearHistory = std::max(shearHistory, s.contact.shear.norm());
+    }
+    EXPECT_GT(rollingHistory, 0.0);
+    EXPECT_GT(shearHistory, 0.0);
+    first.writeRestart(path);
+    first.step(kStepsAfter);
+
+    // Same thread count, same input: the same bits.
+    dem::Simulation again = makeBox(c);
+    again.step(kStepsBefore + kStepsAfter);
+    expectBitwiseEqual(stateOf(first), stateOf(again), "repeated run, " + std::to_string(threadCount) + " threads");
+
+    dem::Simulation continued(settingsFor(c), first.materials(), first.interactions(), first.walls());
+    continued.readRestart(path);
+    EXPECT_EQ(continued.stepCount(), kStepsBefore);
+    continued.step(kStepsAfter);
+    EXPECT_EQ(continued.stepCount(), first.stepCount());
+    EXPECT_EQ(continued.time(), first.time());
+    expectBitwiseEqual(stateOf(first), stateOf(continued), "restart, " + std::to_string(threadCount) + " threads");
+    EXPECT_EQ(continued.lostCount(), first.lostCount());
+    std::remove(path.c_str());
+}
+
+TEST(EngineRestart, BitwiseRepeatAndRestartOneThread) { checkRepeatAndRestart(1); }
+TEST(EngineRestart, BitwiseRepeatAndRestartTwoThreads) { checkRepeatAndRestart(2); }
+
+// ---------------------------------------------------------------------------
+// 8. Regression (Lethe style): 200 spheres settle for 20 000 steps on one
+// thread; every final position and velocity is compared with the committed
+// reference within 1e-9 of the scale (box width for positions, sqrt(g W) for
+// velocities).  The run is chaotic, so a change of the order of floating-point
+// operations (compiler, flags, summation order) may move it beyond that
+// tolerance: then inspect the change and regenerate (see the top of the file).
+
+std::string referencePath() { return std::string(DEMLIB_TEST_DATA_DIR) + "/regression/settle_reference.txt"; }
+
+TEST(EngineRegression, SettlingMatchesCommittedReference) {
+    ThreadCount threads(1);
+    BoxCase c;
+    c.width = 0.010;
+    c.height = 0.025;
+    c.count = 200;
+    c.seed = 2024;
+    dem::Simulation sim = makeBox(c);
+    sim.step(20000);
+    const auto& p = sim.particles();
+    ASSERT_EQ(p.size(), c.count);
+
+    const char* regenerate = std::getenv("DEMLIB_REGENERATE_REFERENCE");
+    if (regenerate && std::string(regenerate) == "1") {
+        std::ofstream out(referencePath());
+        ASSERT_TRUE(out) << "cannot write " << referencePath();
+        out << "# demLib regression: test_engine_bed EngineRegression.SettlingMatchesCommittedReference\n"
+            << "# 200 glass spheres (1-2 mm) settled 20000 steps of 1e-5 s in a 10 mm steel box, 1 thread.\n"
+            << "# Regenerate: DEMLIB_REGENERATE_REFERENCE=1 test_engine_bed --gtest_filter='EngineRegression.*'\n"
+            << "# id x y z vx vy vz [SI]\n";
+        out.precision(17);
+        for (std::size_t i = 0; i < p.size(); ++i)
+            out << p.id[i] << ' ' << p.position[i].x() << ' ' << p.position[i].y() << ' ' << p.position[i].z()
+                << ' ' << p.velocity[i].x() << ' ' << p.velocity[i].y() << ' ' << p.velocity[i].z() << '\n';
+        GTEST_SKIP() << "reference regenerated: " << referencePath();
+    }
+
+    std::ifstream in(referencePath());
+    ASSERT_TRUE(in) << "missing reference " << referencePath()
+                    << " (generate it with DEMLIB_REGENERATE_REFERENCE=1)";
+    std::vector<std::int64_t> ids;
+    std::vector<Vec3> x, v;
+    std::string line;
+    while (std::getline(in, line)) {
+        if (line.empty() || line[0] == '#') continue;
+        std::istringstream s(line);
+        std::int64_t id;
+        Vec3 a, b;
+        s >> id >> a.x() >> a.y() >> a.z() >> b.x() >> b.y() >> b.z();
+        ASSERT_FALSE(s.fail()) << "bad line in reference: " << line;
+        ids.push_back(id);
+        x.push_back(a);
+        v.push_back(b);
+    }
+    ASSERT_EQ(ids.size(), p.size());
+    const double positionScale = c.width;
+    const double velocityScale = std::sqrt(9.81 * c.width);
+    double worstPosition = 0.0, worstVelocity = 0.0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        ASSERT_EQ(p.id[i], ids[i]);
+        worstPosition = std::max(worstPosition, (p.position[i] - x[i]).cwiseAbs().maxCoeff() / positionScale);
+        worstVelocity = std::max(worstVelocity, (p.velocity[i] - v[i]).cwiseAbs().maxCoeff() / velocityScale);
+    }
+    std::printf("regression: worst relative deviation position %.3e, velocity %.3e\n", worstPosition,
+                worstVelocity);
+    EXPECT_LT(worstPosition, 1e-9);
+    EXPECT_LT(worstVelocity, 1e-9);
+}
+
+}  // namespace

@@ -1,0 +1,66 @@
+#!/usr/bin/python3
+"""Plot the CSV written by demCapillaryScaling (capillary force vs coarse-grain factor).
+
+Usage: plotCapillaryScaling.py [capillaryScaling.csv] [capillaryScaling.png]
+
+Left: capillary force for particles l times larger, normalised by l = 1, for the
+readings the app evaluates, against the paper's fit 0.95 l + 0.056.
+Right: capillary Bond number (capillary force / particle weight) relative to
+l = 1 without eq 9, with eq 9 (kappa = 2.0142) and with kappa = 2.
+"""
+import csv
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402  (backend must be chosen first)
+
+
+def read_columns(path):
+    with open(path, newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    if not rows:
+        sys.exit(f"plotCapillaryScaling: '{path}' has no data rows")
+    return {key: [float(row[key]) for row in rows] for key in rows[0]}
+
+
+def main(argv):
+    if any(arg in ("-h", "-help", "--help") for arg in argv[1:]):
+        print(__doc__)
+        return 0
+    source = argv[1] if len(argv) > 1 else "capillaryScaling.csv"
+    target = argv[2] if len(argv) > 2 else source.rsplit(".", 1)[0] + ".png"
+    data = read_columns(source)
+    scale = data["l"]
+
+    figure, (forces, bond) = plt.subplots(1, 2, figsize=(11, 4.5))
+    forces.plot(scale, data["ratioContact"], "o-", label="eqs 1-5, radii and $V_b \\times l^3$ (contact)")
+    forces.plot(scale, data["ratioGap"], "s--", label="eqs 1-5, radii and $V_b \\times l^3$ (gap $\\times l$)")
+    forces.plot(scale, data["ratioFixedVolumeContact"], "^-", label="radii $\\times l$, $V_b$ unscaled (contact)")
+    if any(value != 0.0 for value in data["ratioFixedVolumeFixedGap"]):
+        forces.plot(scale, data["ratioFixedVolumeFixedGap"], "v-", label="radii $\\times l$, $V_b$ and gap unscaled")
+    forces.plot(scale, data["paperFit"], "k:", label="paper fit $0.95\\,l + 0.056$")
+    forces.set_xlabel("coarse-grain factor $l$")
+    forces.set_ylabel("$f^C_n(l) / f^C_n(1)$")
+    forces.set_title("Capillary force vs scale")
+    forces.grid(True, alpha=0.3)
+    forces.legend(fontsize=8)
+
+    bond.semilogy(scale, data["bondRatioUncorrected"], "o-", label="no correction ($\\propto l^{-2}$)")
+    bond.semilogy(scale, data["bondRatioEq9"], "s-", label="eq 9, $\\kappa = 2.0142$")
+    bond.semilogy(scale, data["bondRatioKappa2"], "k--", label="$\\kappa = 2$ (exact)")
+    bond.set_xlabel("coarse-grain factor $l$")
+    bond.set_ylabel("$Bo(l) / Bo(1)$,  $Bo = |f^C_n| / (m g)$")
+    bond.set_title("Capillary Bond number")
+    bond.grid(True, which="both", alpha=0.3)
+    bond.legend(fontsize=8)
+
+    figure.tight_layout()
+    figure.savefig(target, dpi=150)
+    print(f"plotCapillaryScaling: wrote {target}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
