@@ -6,8 +6,7 @@
 // Regression reference: tests/demLib/data/regression/settle_reference.txt.
 // After a deliberate change of the physics or of the order of floating-point
 // operations, regenerate it with
-//     DEMLIB_REGENERATE_REFERENCE=1 build/enginetests/tests/test_engine_bed \
-//         --gtest_filter='EngineRegression.*'
+//     DEMLIB_REGENERATE_REFERENCE=1 build/enginetests/tests/test_engine_bed --gtest_filter='EngineRegression.*'
 // and commit the new file together with the change that explains it.
 #include <gtest/gtest.h>
 
@@ -62,7 +61,7 @@ private:
 // particles glass.  floorVelocity != 0 makes the floor slide in its own plane.
 struct BoxCase {
     double width = 0.012;
-    double height = 0.03;
+    double height = 0.04;
     std::size_t count = 500;
     double dMin = 1.0e-3;
     double dMax = 2.0e-3;
@@ -139,11 +138,13 @@ double potentialEnergy(const dem::ParticleStore& p) {
 // the bed, one largest diameter away from the side walls and the floor and two
 // below the surface, where the wall ordering does not reach.
 //
-// Height: the bed height predicted from that solid fraction,
-// H = V_solid / (A phi_core), is compared with the measured surface height
-// (where the cross-section solid fraction falls to half the core value).
-// The measured bed is a little taller because the layer at the walls packs
-// looser than the core; the tolerance is 8 %.
+// Height: in a box only 6-12 diameters wide the layers at the walls pack
+// looser than the core (a 10 % taller bed than phi_core predicts), so the
+// height is predicted from the solid fraction of the whole cross-section
+// below the surface region, H = V_solid / (A phi_bulk), and compared with the
+// measured surface (where a thin slice's solid fraction falls to half of
+// phi_bulk) within 3 %: overlapping or lost particles, or spheres hovering
+// above the bed, would break it.
 
 // Fraction of grid points in [lo, hi] that lie inside some sphere.
 double solidFraction(const dem::ParticleStore& p, const Vec3& lo, const Vec3& hi, int n) {
@@ -162,6 +163,51 @@ double solidFraction(const dem::ParticleStore& p, const Vec3& lo, const Vec3& hi
     return static_cast<double>(inside) / total;
 }
 
+// Kinetic energy that the contacts can dissipate.  Hertz-Mindlin (as in
+// LIGGGHTS) has no twisting resistance: a sphere that rests on ONE contact
+// (a rattler on the floor) keeps any spin about that contact's normal forever,
+// since a point contact exerts no torque about it.  That spin is a constant of
+// the model, not a failure to settle; it is reported separately.
+struct SettlingEnergy {
+    double dissipatable = 0.0;  // translation + rotation except the free spin
+    double freeSpin = 0.0;      // spin of single-contact spheres about their contact normal
+};
+
+SettlingEnergy settlingEnergy(const dem::Simulation& sim) {
+    const dem::ParticleStore& p = sim.particles();
+    const std::size_t n = p.size();
+    std::vector<int> contacts(n, 0);
+    std::vector<Vec3> normal(n, Vec3::Zero());
+    for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t j = i + 1; j < n; ++j) {
+            const Vec3 d = p.position[i] - p.position[j];
+            if (d.norm() < p.radius[i] + p.radius[j]) {
+                ++contacts[i];
+                ++contacts[j];
+                normal[i] = normal[j] = d.normalized();
+            }
+        }
+    for (const dem::WallContactRecord& r : sim.wallContacts().records()) {
+        std::vector<dem::WallContact> found;
+        sim.walls()[r.wall].findContacts(p.position[r.particle], p.radius[r.particle], sim.time(), found);
+        for (const dem::WallContact& c : found)
+            if (c.feature == r.feature && c.overlap > 0.0) {
+                ++contacts[r.particle];
+                normal[r.particle] = c.normal;
+            }
+    }
+    SettlingEnergy e;
+    for (std::size_t i = 0; i < n; ++i) {
+        const double inertia = 0.4 * p.mass[i] * p.radius[i] * p.radius[i];
+        double spin = 0.0;
+        if (contacts[i] == 1) spin = 0.5 * inertia * std::pow(p.omega[i].dot(normal[i]), 2);
+        e.dissipatable += 0.5 * p.mass[i] * p.velocity[i].squaredNorm() +
+                          0.5 * inertia * p.omega[i].squaredNorm() - spin;
+        e.freeSpin += spin;
+    }
+    return e;
+}
+
 TEST(EngineBed, PouredBedSettlesInsideTheBoxWithSoundPacking) {
     ThreadCount threads(1);
     BoxCase c;
@@ -171,15 +217,18 @@ TEST(EngineBed, PouredBedSettlesInsideTheBoxWithSoundPacking) {
     const double u0 = potentialEnergy(p);
     double kineticOverDrop = 1.0;
     double maxKinetic = 0.0;
+    SettlingEnergy energy;
     while (sim.time() < 1.0) {
         sim.step(2000);
         maxKinetic = std::max(maxKinetic, p.kineticEnergy());
-        kineticOverDrop = p.kineticEnergy() / (u0 - potentialEnergy(p));
+        energy = settlingEnergy(sim);
+        kineticOverDrop = energy.dissipatable / (u0 - potentialEnergy(p));
         if (sim.time() > 0.2 && kineticOverDrop < 1e-6) break;
     }
     const double drop = u0 - potentialEnergy(p);
-    std::printf("bed: settled at t = %.3f s, KE / potential drop = %.3e (peak KE / drop %.3e)\n", sim.time(),
-                kineticOverDrop, maxKinetic / drop);
+    std::printf("bed: settled at t = %.3f s, KE / potential drop = %.3e (free spin of single-contact spheres "
+                "%.3e, peak KE %.3e)\n",
+                sim.time(), kineticOverDrop, energy.freeSpin / drop, maxKinetic / drop);
     EXPECT_LT(kineticOverDrop, 1e-6);
     EXPECT_GT(maxKinetic / drop, 0.05);  // it really fell
     EXPECT_EQ(sim.lostCount(), 0u);
@@ -206,23 +255,27 @@ TEST(EngineBed, PouredBedSettlesInsideTheBoxWithSoundPacking) {
     EXPECT_LT(maxOverlapRatio, 0.02);
 
     // Surface height: where the solid fraction of a thin full-width slice falls
-    // below half of the core value.
+    // below half of the bulk value.
     const double m = c.dMax;
     const double coreTop = top - 2.0 * m;
     ASSERT_GT(coreTop, 2.0 * m);
-    const double phiCore =
-        solidFraction(p, Vec3(m, m, m), Vec3(c.width - m, c.width - m, coreTop), 40);
+    const double phiCore = solidFraction(p, Vec3(m, m, m), Vec3(c.width - m, c.width - m, coreTop), 40);
+    // Whole cross-section up to the same height: includes the looser layers at
+    // the walls and the floor, so it predicts the height of this box.
+    const double phiBulk = solidFraction(p, Vec3(0, 0, 0), Vec3(c.width, c.width, coreTop), 40);
     double surface = 0.0;
     for (double z = 0.0; z < top; z += 0.05 * m) {
         const double phiSlice = solidFraction(p, Vec3(0, 0, z), Vec3(c.width, c.width, z + 0.05 * m), 30);
-        if (phiSlice >= 0.5 * phiCore) surface = z + 0.025 * m;
+        if (phiSlice >= 0.5 * phiBulk) surface = z + 0.025 * m;
     }
-    const double predicted = solidVolume / (c.width * c.width * phiCore);
-    std::printf("bed: phi_core = %.4f, surface %.3f mm, predicted %.3f mm (ratio %.4f), max overlap/r %.4f\n",
-                phiCore, 1e3 * surface, 1e3 * predicted, surface / predicted, maxOverlapRatio);
+    const double predicted = solidVolume / (c.width * c.width * phiBulk);
+    std::printf("bed: phi_core = %.4f, phi_bulk = %.4f, surface %.3f mm, predicted %.3f mm (ratio %.4f), "
+                "max overlap/r %.4f\n",
+                phiCore, phiBulk, 1e3 * surface, 1e3 * predicted, surface / predicted, maxOverlapRatio);
     EXPECT_GT(phiCore, 0.55);
     EXPECT_LT(phiCore, 0.64);
-    EXPECT_NEAR(surface / predicted, 1.0, 0.08);
+    EXPECT_LT(phiBulk, phiCore);  // walls loosen the packing next to them
+    EXPECT_NEAR(surface / predicted, 1.0, 0.03);
 }
 
 // ---------------------------------------------------------------------------
@@ -250,7 +303,7 @@ void expectBitwiseEqual(const State& a, const State& b, const std::string& what)
 BoxCase restartCase() {
     BoxCase c;
     c.width = 0.008;
-    c.height = 0.02;
+    c.height = 0.03;
     c.count = 150;
     c.floorVelocity = Vec3(0.02, 0.0, 0.0);
     c.seed = 5;

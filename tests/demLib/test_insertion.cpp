@@ -481,6 +481,9 @@ TEST(Placement, RegionTooSmallReportsRequestedAndMaximalMass) {
     request.placement.whenFull = dem::WhenRegionFull::PlaceWhatFits;
     EXPECT_EQ(dem::insertParticles(box, mono, request).size(), 27u);
 
+    request.targetMass = 0.1 * m;  // rounds to no particle at all
+    EXPECT_THROW(dem::insertParticles(box, mono, request), InputError);
+    request.targetMass = 30.0 * m;
     request.targetCount = 5;  // both targets set
     EXPECT_THROW(dem::insertParticles(box, mono, request), InputError);
 }

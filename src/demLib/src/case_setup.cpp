@@ -123,8 +123,11 @@ std::vector<Wall> readWalls(const Dictionary& root, const std::string& caseDir,
 std::shared_ptr<SizeDistribution> readDistribution(const Dictionary& d, double scale, const std::string& context) {
     if (d.has("diameter") && d.has("sizeDistribution"))
         invalid(d, "diameter", "give either 'diameter' (monodisperse) or 'sizeDistribution', not both");
-    if (d.has("diameter"))
-        return std::make_shared<SizeDistribution>(SizeDistribution::monodisperse(d.getPositive("diameter"), scale, context));
+    if (d.has("diameter")) {
+        const double diameter = d.get<double>("diameter");
+        if (!(diameter > 0.0)) invalid(d, "diameter", "expected a positive diameter, got " + std::to_string(diameter));
+        return std::make_shared<SizeDistribution>(SizeDistribution::monodisperse(diameter, scale, context));
+    }
     if (!d.has("sizeDistribution"))
         invalid(d, "sizeDistribution", "missing; expected 'diameter <d>;' or 'sizeDistribution { classes ((dMin dMax massPercent) ...); }'");
     const Dictionary& s = d.subDict("sizeDistribution");
@@ -150,9 +153,20 @@ std::vector<InsertionSpec> readInsertions(const Dictionary& root, const CaseSetu
         const Dictionary& d = all.subDict(name);
         InsertionSpec spec;
         spec.name = name;
-        spec.context = d.describe("region").substr(0, d.describe("region").find(", keyword")) + ", insertion '" + name + "'";
+        spec.context = d.fileName() + ": insertion '" + name + "'";
         spec.materialIndex = materialByName(d, "material", setup.materials);
         spec.time = d.has("time") ? d.getNonNegative("time") : 0.0;
+        if (d.has("positions")) {
+            // Explicit particles: the user's positions, one diameter (times the
+            // coarse-grain factor); checked against the walls on insertion.
+            const double diameter = d.get<double>("diameter");
+            if (!(diameter > 0.0)) invalid(d, "diameter", "expected a positive diameter, got " + std::to_string(diameter));
+            for (const Vec3& x : d.get<std::vector<Vec3>>("positions"))
+                spec.explicitParticles.push_back({x, 0.5 * diameter * setup.coarseGrain.factor});
+            spec.request.initialVelocity = d.getOrDefault<Vec3>("velocity", Vec3::Zero());
+            out.push_back(std::move(spec));
+            continue;
+        }
         spec.region = readRegion(d.subDict("region"), setup.caseDir);
         spec.distribution = readDistribution(d, setup.coarseGrain.factor, spec.context);
         const bool byMass = d.has("mass");
@@ -324,6 +338,10 @@ std::unique_ptr<Simulation> makeSimulation(const CaseSetup& setup) {
 }
 
 std::size_t performInsertion(Simulation& sim, const InsertionSpec& spec) {
+    if (!spec.explicitParticles.empty()) {
+        sim.insert(spec.explicitParticles, spec.materialIndex, spec.request.initialVelocity, spec.context);
+        return spec.explicitParticles.size();
+    }
     InsertionRequest request = spec.request;
     const ParticleStore& p = sim.particles();
     request.placement.existing.positions = &p.position;

@@ -454,9 +454,20 @@ const Dictionary::Entry* Dictionary::query(const std::string& key) const {
 
 const Dictionary::Entry& Dictionary::require(const std::string& key, const std::string& expected) const {
     const Entry* e = query(key);
-    if (!e)
+    if (!e) {
+        // A missing keyword is often a misspelt one: point at the unread entry
+        // that looks most like it.
+        std::vector<std::string> unread;
+        for (const auto& entry : entries_)
+            if (!entry.used) unread.push_back(entry.name);
+        const std::string suggestion = closest(key, unread);
+        std::string hint;
+        if (!suggestion.empty())
+            hint = "; found '" + suggestion + "' on line " + std::to_string(find(suggestion)->line) +
+                   " instead: did you mean '" + key + "'?";
         throw InputError(at(file_, line_) + "keyword '" + scope_ + "/" + key + "' is missing" +
-                         (line_ > 0 ? " from the block opened on this line" : "") + "; expected " + expected);
+                         (line_ > 0 ? " from the block opened on this line" : "") + "; expected " + expected + hint);
+    }
     return *e;
 }
 

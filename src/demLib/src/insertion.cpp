@@ -315,7 +315,7 @@ std::vector<InsertedParticle> placeWithMessage(const Region& region,
 
 std::string describeLattice(const PlacementOptions& options, double spacing) {
     std::ostringstream m;
-    m << "lattice spacing " << spacing << " (" << latticeName(options.lattice)
+    m << "lattice spacing " << spacing << " m (" << latticeName(options.lattice)
       << ", gapFraction " << options.gapFraction << ")";
     return m.str();
 }
@@ -529,6 +529,10 @@ std::vector<InsertedParticle> insertParticles(const Region& region,
         byMass ? drawDiametersForMass(distribution, request.targetMass, request.density,
                                       request.placement.seed)
                : drawDiametersForCount(distribution, request.targetCount, request.placement.seed);
+    if (diameters.empty())
+        throw InputError(context + ": targetMass " + formatNumber(request.targetMass) +
+                         " kg is less than half the mass of one particle; expected at least " +
+                         formatNumber(0.5 * sphereMass(distribution.dMin(), request.density)) + " kg");
 
     return placeWithMessage(region, diameters, request.placement, [&](std::size_t fits, double spacing) {
         // The population is in random order, so its leading part is a fair sample.

@@ -26,6 +26,8 @@ struct InsertionSpec {
     std::shared_ptr<Region> region;
     std::shared_ptr<SizeDistribution> distribution;
     InsertionRequest request;
+    // Particles listed explicitly ('positions' + 'diameter'), placed as given.
+    std::vector<InsertedParticle> explicitParticles;
     std::string context;  // "file: insertion/<name>" for messages
 };
 

@@ -1,0 +1,355 @@
+// demBench: the performance benchmark driver of bench/run (issue 7).
+//
+//   demBench settle -case DIR -out PREFIX [-threads N] [-placement rsa|lattice]
+//                   [-packing PHI] [-gravityFactor G] [-settleTime T] [-relaxTime T]
+//                   [-speedTolerance V]
+//       Builds the bed of DIR/constant/demProperties (its first insertion
+//       block: region, size distribution, count) and lets it settle; writes
+//       PREFIX.bed (text: "x y z radius" per particle, the input of both demLib
+//       and LIGGGHTS timing runs) and PREFIX.restart.h5.
+//
+//   demBench time -case DIR -bed FILE -steps K [-threads N] [-sample S]
+//       Inserts the bed at rest (no contact history, exactly what LIGGGHTS gets
+//       from read_data), applies the case's waterContent for the capillary
+//       model, takes one untimed step (first pair list and forces, like the
+//       LIGGGHTS 'run' setup) and times K steps.  Prints 'sample' lines (step,
+//       coordination number, kinetic energy) every S steps and 'result' lines
+//       (key value) that bench/run parses.
+//
+// Settling from a loose packing under gravity takes long in physical time
+// (the top of the column falls by half the bed height); -gravityFactor G > 1
+// shortens it (sqrt(G) times), after which the bed relaxes under 1 g for
+// -relaxTime, so the stored bed carries the 1 g overlaps.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "demLib/case_setup.hpp"
+#include "demLib/error.hpp"
+#include "demLib/simulation.hpp"
+
+namespace {
+
+constexpr double pi = 3.14159265358979323846;
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Peak and current resident set size in bytes (Linux /proc/self/status).
+std::size_t procStatusBytes(const std::string& key) {
+    std::ifstream in("/proc/self/status");
+    std::string line;
+    while (std::getline(in, line)) {
+        if (line.compare(0, key.size() + 1, key + ":") == 0) {
+            std::istringstream s(line.substr(key.size() + 1));
+            std::size_t kib = 0;
+            s >> kib;
+            return kib * 1024;
+        }
+    }
+    return 0;
+}
+
+struct Options {
+    std::map<std::string, std::string> values;
+    bool has(const std::string& k) const { return values.count(k) > 0; }
+    std::string get(const std::string& k, const std::string& fallback = "") const {
+        const auto it = values.find(k);
+        if (it != values.end()) return it->second;
+        if (fallback.empty()) throw dem::InputError("demBench: option -" + k + " is required");
+        return fallback;
+    }
+    double number(const std::string& k, double fallback) const {
+        return has(k) ? std::atof(values.at(k).c_str()) : fallback;
+    }
+};
+
+struct BedParticle {
+    dem::Vec3 position;
+    double radius;
+};
+
+// Random sequential addition of the population into the insertion region's
+// bounding box, largest first: a loose, isotropic, overlap-free packing that
+// any size distribution reaches (the insertion lattice is spaced by the largest
+// diameter, far too loose for a 1:5 size ratio).  The box height is cut to the
+// one that holds the solid volume at the target packing fraction.
+std::vector<dem::InsertedParticle> randomSequentialAddition(const dem::InsertionSpec& spec,
+                                                            double packingFraction) {
+    const dem::SizeDistribution& dist = *spec.distribution;
+    std::size_t count = spec.request.targetCount;
+    if (count == 0)
+        throw dem::InputError("demBench: the benchmark case's insertion block must give 'count'");
+    std::vector<double> d = dem::drawDiametersForCount(dist, count, spec.request.placement.seed);
+    std::sort(d.begin(), d.end(), std::greater<double>());
+    double solid = 0.0;
+    for (double di : d) solid += pi / 6.0 * di * di * di;
+    const dem::Vec3 lo = spec.region->boundsMin();
+    dem::Vec3 hi = spec.region->boundsMax();
+    const double base = (hi.x() - lo.x()) * (hi.y() - lo.y());
+    hi.z() = std::min(hi.z(), lo.z() + solid / (packingFraction * base));
+
+    const double cell = d.front();
+    const int nx = std::max(1, static_cast<int>((hi.x() - lo.x()) / cell));
+    const int ny = std::max(1, static_cast<int>((hi.y() - lo.y()) / cell));
+    const int nz = std::max(1, static_cast<int>((hi.z() - lo.z()) / cell));
+    auto cellIndex = [&](const dem::Vec3& x, int& cx, int& cy, int& cz) {
+        cx = std::clamp(static_cast<int>((x.x() - lo.x()) / (hi.x() - lo.x()) * nx), 0, nx - 1);
+        cy = std::clamp(static_cast<int>((x.y() - lo.y()) / (hi.y() - lo.y()) * ny), 0, ny - 1);
+        cz = std::clamp(static_cast<int>((x.z() - lo.z()) / (hi.z() - lo.z()) * nz), 0, nz - 1);
+    };
+    std::vector<std::vector<int>> grid(static_cast<std::size_t>(nx) * ny * nz);
+    std::vector<dem::InsertedParticle> placed;
+    placed.reserve(count);
+    std::mt19937_64 random(spec.request.placement.seed + 0x9e3779b97f4a7c15ULL);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    const long maxAttempts = 200000;
+    for (double di : d) {
+        const double r = 0.5 * di;
+        bool done = false;
+        for (long attempt = 0; attempt < maxAttempts && !done; ++attempt) {
+            const dem::Vec3 x(lo.x() + r + unit(random) * (hi.x() - lo.x() - 2 * r),
+                              lo.y() + r + unit(random) * (hi.y() - lo.y() - 2 * r),
+                              lo.z() + r + unit(random) * (hi.z() - lo.z() - 2 * r));
+            int cx, cy, cz;
+            cellIndex(x, cx, cy, cz);
+            bool free = true;
+            for (int z = std::max(0, cz - 1); z <= std::min(nz - 1, cz + 1) && free; ++z)
+                for (int y = std::max(0, cy - 1); y <= std::min(ny - 1, cy + 1) && free; ++y)
+                    for (int xx = std::max(0, cx - 1); xx <= std::min(nx - 1, cx + 1) && free; ++xx)
+                        for (int k : grid[(static_cast<std::size_t>(z) * ny + y) * nx + xx]) {
+                            const double reach = r + placed[k].radius;
+                            if ((placed[k].position - x).squaredNorm() < reach * reach) {
+                                free = false;
+                                break;
+                            }
+                        }
+            if (!free) continue;
+            grid[(static_cast<std::size_t>(cz) * ny + cy) * nx + cx].push_back(static_cast<int>(placed.size()));
+            placed.push_back({x, r});
+            done = true;
+        }
+        if (!done) {
+            std::ostringstream s;
+            s << "demBench: random sequential addition placed only " << placed.size() << " of " << count
+              << " particles at packing fraction " << packingFraction
+              << "; expected a lower -packing or a larger insertion region";
+            throw dem::InputError(s.str());
+        }
+    }
+    return placed;
+}
+
+double rmsSpeed(const dem::ParticleStore& p) {
+    double s = 0.0;
+    for (const dem::Vec3& v : p.velocity) s += v.squaredNorm();
+    return p.empty() ? 0.0 : std::sqrt(s / p.size());
+}
+
+std::vector<dem::InsertedParticle> currentBed(const dem::ParticleStore& p) {
+    std::vector<dem::InsertedParticle> bed(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) bed[i] = {p.position[i], p.radius[i]};
+    return bed;
+}
+
+// Runs until `time` has passed or, after a tenth of it, the rms speed is below
+// `tolerance`; returns the simulated time.
+double settleFor(dem::Simulation& sim, double time, double tolerance, const std::string& phase) {
+    const auto start = Clock::now();
+    const long steps = static_cast<long>(std::ceil(time / sim.timeStep()));
+    const long chunk = 500;
+    long done = 0;
+    while (done < steps) {
+        const long k = std::min(chunk, steps - done);
+        sim.step(k);
+        done += k;
+        const double v = rmsSpeed(sim.particles());
+        std::cout << phase << ": t " << std::setprecision(4) << done * sim.timeStep() << " s, rms speed " << v
+                  << " m/s, coordination " << sim.coordinationNumber() << ", " << std::setprecision(3)
+                  << secondsSince(start) << " s wall" << std::endl;
+        if (done * sim.timeStep() > 0.1 * time && v < tolerance) break;
+    }
+    return done * sim.timeStep();
+}
+
+int settle(const Options& o) {
+    const std::string caseDir = o.get("case");
+    const std::string out = o.get("out");
+    dem::CaseSetup setup = dem::readCaseSetup(caseDir);
+    if (setup.insertions.empty())
+        throw dem::InputError(setup.propertiesFile + ": demBench expects one insertion block");
+    const dem::InsertionSpec& spec = setup.insertions.front();
+    const std::string placement = o.get("placement", "rsa");
+
+    dem::CaseSetup loose = setup;
+    loose.settings.gravity *= o.number("gravityFactor", 1.0);
+    std::unique_ptr<dem::Simulation> sim = dem::makeSimulation(loose);
+    if (placement == "rsa") {
+        sim->insert(randomSequentialAddition(spec, o.number("packing", 0.3)), spec.materialIndex,
+                    dem::Vec3::Zero(), spec.context);
+    } else if (placement == "lattice") {
+        dem::performInsertion(*sim, spec);
+    } else {
+        throw dem::InputError("demBench: -placement expects 'rsa' or 'lattice'");
+    }
+    std::cout << "settle: " << sim->particles().size() << " particles placed (" << placement << ")" << std::endl;
+    const double tolerance = o.number("speedTolerance", 2e-3);
+    settleFor(*sim, o.number("settleTime", 0.05), tolerance, "settle");
+
+    // Relax under the true gravity from rest, then store.
+    std::unique_ptr<dem::Simulation> relaxed = dem::makeSimulation(setup);
+    relaxed->insert(currentBed(sim->particles()), spec.materialIndex, dem::Vec3::Zero(), spec.context);
+    sim.reset();
+    settleFor(*relaxed, o.number("relaxTime", 0.01), tolerance, "relax");
+
+    const dem::ParticleStore& p = relaxed->particles();
+    std::ofstream bed(out + ".bed");
+    bed << "# demBench settled bed: x y z radius [m]; " << p.size() << " particles, coordination "
+        << relaxed->coordinationNumber() << "\n";
+    bed << std::setprecision(17);
+    for (std::size_t i = 0; i < p.size(); ++i)
+        bed << p.position[i].x() << ' ' << p.position[i].y() << ' ' << p.position[i].z() << ' ' << p.radius[i]
+            << '\n';
+    if (!bed) throw dem::RuntimeError("demBench: cannot write '" + out + ".bed'");
+    relaxed->writeRestart(out + ".restart.h5");
+    std::cout << "settle: wrote " << out << ".bed and " << out << ".restart.h5" << std::endl;
+    return 0;
+}
+
+std::vector<dem::InsertedParticle> readBed(const std::string& file) {
+    std::ifstream in(file);
+    if (!in) throw dem::InputError("demBench: cannot open bed file '" + file + "'");
+    std::vector<dem::InsertedParticle> bed;
+    std::string line;
+    while (std::getline(in, line)) {
+        if (line.empty() || line[0] == '#') continue;
+        std::istringstream s(line);
+        dem::InsertedParticle q;
+        if (!(s >> q.position.x() >> q.position.y() >> q.position.z() >> q.radius))
+            throw dem::InputError("demBench: bed file '" + file + "': expected 'x y z radius' in line '" + line + "'");
+        bed.push_back(q);
+    }
+    return bed;
+}
+
+int timeSteps(const Options& o) {
+    const std::string caseDir = o.get("case");
+    dem::CaseSetup setup = dem::readCaseSetup(caseDir);
+    const int material = setup.insertions.empty() ? 0 : setup.insertions.front().materialIndex;
+    const long steps = static_cast<long>(o.number("steps", 1000));
+    const long sample = std::max(1L, static_cast<long>(o.number("sample", 100)));
+
+    const std::size_t rssBefore = procStatusBytes("VmRSS");
+    std::unique_ptr<dem::Simulation> sim = dem::makeSimulation(setup);
+    {
+        const std::vector<dem::InsertedParticle> bed = readBed(o.get("bed"));
+        sim->insert(bed, material, dem::Vec3::Zero(), "bed");
+    }
+    if (setup.waterContent > 0.0) sim->setWaterContent(setup.waterContent);
+    const std::size_t n = sim->particles().size();
+
+    sim->step(1);  // first pair list and forces: LIGGGHTS does this in its run setup
+    std::cout << "sample 0 " << std::setprecision(8) << sim->coordinationNumber() << ' '
+              << sim->particles().kineticEnergy() << std::endl;
+    double coordinationSum = 0.0;
+    int samples = 0;
+    const long buildsBefore = sim->pairList().buildCount();
+    const auto start = Clock::now();
+    double sampling = 0.0;
+    for (long done = 0; done < steps;) {
+        const long k = std::min(sample, steps - done);
+        sim->step(k);
+        done += k;
+        const auto t0 = Clock::now();
+        coordinationSum += sim->coordinationNumber();
+        ++samples;
+        std::cout << "sample " << done << ' ' << sim->coordinationNumber() << ' ' << sim->particles().kineticEnergy()
+                  << std::endl;
+        sampling += secondsSince(t0);
+    }
+    const double seconds = secondsSince(start) - sampling;
+    const dem::ParticleStore& p = sim->particles();
+
+    std::cout << std::setprecision(6);
+#ifdef _OPENMP
+    std::cout << "result threads " << omp_get_max_threads() << "\n";
+#else
+    std::cout << "result threads 1\n";
+#endif
+    std::cout << "result particles " << n << "\n"
+              << "result steps " << steps << "\n"
+              << "result seconds " << seconds << "\n"
+              << "result particle_steps_per_s " << static_cast<double>(n) * steps / seconds << "\n"
+              << "result list_builds " << sim->pairList().buildCount() - buildsBefore << "\n"
+              << "result coordination_mean " << coordinationSum / samples << "\n"
+              << "result coordination_end " << sim->coordinationNumber() << "\n"
+              << "result kinetic_energy_end " << p.kineticEnergy() << "\n"
+              << "result liquid_coordination " << sim->liquidCoordinationNumber() << "\n"
+              << "result particle_bytes_per_particle " << p.bytesPerParticle() << "\n"
+              << "result pair_list_entries_per_particle " << static_cast<double>(sim->pairList().pairCount()) / n
+              << "\n"
+              << "result pair_list_bytes_per_particle " << static_cast<double>(sim->pairList().bytes()) / n << "\n"
+              << "result rss_growth_bytes_per_particle "
+              << (static_cast<double>(procStatusBytes("VmRSS")) - static_cast<double>(rssBefore)) / n << "\n"
+              << "result vmhwm_bytes " << procStatusBytes("VmHWM") << std::endl;
+    return 0;
+}
+
+void usage(std::ostream& out) {
+    out << "Usage: demBench settle -case DIR -out PREFIX [-threads N] [-placement rsa|lattice] [-packing PHI]\n"
+           "                       [-gravityFactor G] [-settleTime T] [-relaxTime T] [-speedTolerance V]\n"
+           "       demBench time -case DIR -bed FILE -steps K [-threads N] [-sample S]\n"
+           "Benchmark driver of bench/run; see docs/performance.md.\n";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    if (argc < 2 || std::string(argv[1]) == "-help" || std::string(argv[1]) == "--help") {
+        usage(argc < 2 ? std::cerr : std::cout);
+        return argc < 2 ? 1 : 0;
+    }
+    const std::string command = argv[1];
+    Options o;
+    for (int i = 2; i < argc; ++i) {
+        const std::string a = argv[i];
+        if (a.size() < 2 || a[0] != '-' || i + 1 >= argc) {
+            std::cerr << "demBench: expected '-option value' pairs, got '" << a << "'\n";
+            usage(std::cerr);
+            return 1;
+        }
+        o.values[a.substr(1)] = argv[++i];
+    }
+#ifdef _OPENMP
+    if (o.has("threads")) omp_set_num_threads(std::max(1, std::atoi(o.values["threads"].c_str())));
+#endif
+    try {
+        if (command == "settle") return settle(o);
+        if (command == "time") return timeSteps(o);
+        std::cerr << "demBench: unknown command '" << command << "'; expected 'settle' or 'time'\n";
+        usage(std::cerr);
+        return 1;
+    } catch (const dem::InputError& e) {
+        std::cerr << "demBench: input error: " << e.what() << std::endl;
+        return 1;
+    } catch (const std::exception& e) {
+        std::cerr << "demBench: error: " << e.what() << std::endl;
+        return 2;
+    }
+}
