@@ -47,9 +47,7 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
     if (!restart.empty()) {
         simulation_->readRestart(restart);
         startTime_ = simulation_->time();
-        // Insertions at or before the restart time are in the restart file.
-        for (const InsertionSpec& s : setup_.insertions)
-            if (s.time <= startTime_) ++insertionsDone_;
+        readRunnerState(restart);
         log_ << "Continuing from restart file " << restart << " at t = " << startTime_ << " s, step "
              << simulation_->stepCount() << ", " << simulation_->particles().size() << " particles\n";
     }
@@ -89,6 +87,16 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
     stepsAtStart_ = simulation_->stepCount();
 }
 
+void CaseRunner::readRunnerState(const std::string& restartFile) {
+    std::ifstream in(restartFile + ".runner");
+    if (!(in >> insertionsDone_ >> placed_ >> nextWaveTime_))
+        throw InputError("restart file '" + restartFile + "' has no readable companion '" + restartFile +
+                         ".runner' (insertion progress); expected the pair written by demRun");
+    if (insertionsDone_ > setup_.insertions.size())
+        throw InputError("restart file '" + restartFile + "' records more insertion blocks than the case defines");
+    if (placed_ > 0) population_ = drawPopulation(setup_.insertions[insertionsDone_]);
+}
+
 std::string CaseRunner::outputDirectory() const {
     return (fs::path(setup_.caseDir) / setup_.output.directory).string();
 }
@@ -105,14 +113,30 @@ std::string CaseRunner::latestRestart() const {
 void CaseRunner::performDueInsertions() {
     while (insertionsDone_ < setup_.insertions.size()) {
         const InsertionSpec& spec = setup_.insertions[insertionsDone_];
-        if (spec.time > simulation_->time() + 1e-12) break;
-        const std::size_t n = performInsertion(*simulation_, spec);
-        double mass = 0.0;
+        const double now = simulation_->time();
+        if (spec.time > now + 1e-12) break;
+        if (placed_ > 0 && now < nextWaveTime_ - 1e-12) break;  // the last wave is still settling
+        if (placed_ == 0) population_ = drawPopulation(spec);
         const ParticleStore& p = simulation_->particles();
-        for (std::size_t i = p.size() - n; i < p.size(); ++i) mass += p.mass[i];
-        log_ << "Inserted " << n << " particles (" << mass * 1e3 << " g) of '" << spec.name << "' at t = "
-             << simulation_->time() << " s\n";
+        const std::size_t before = p.size();
+        const std::size_t n = performInsertion(*simulation_, spec, population_, placed_);
+        double mass = 0.0;
+        for (std::size_t i = before; i < p.size(); ++i) mass += p.mass[i];
+        placed_ += n;
+        log_ << "Inserted " << n << " particles (" << mass * 1e3 << " g) of '" << spec.name << "' at t = " << now
+             << " s";
+        if (placed_ < population_.size()) {
+            if (n == 0 && simulation_->particles().size() == before && spec.waveInterval <= 0.0)
+                throw InputError(spec.context + ": no particle fits in the region");
+            nextWaveTime_ = now + spec.waveInterval;
+            log_ << "; " << population_.size() - placed_ << " more in the next wave at t = " << nextWaveTime_
+                 << " s" << std::endl;
+            break;
+        }
+        log_ << std::endl;
         ++insertionsDone_;
+        placed_ = 0;
+        population_.clear();
     }
 }
 
@@ -148,6 +172,11 @@ void CaseRunner::writeRestart() {
     std::ostringstream name;
     name << "restart_" << std::setw(9) << std::setfill('0') << simulation_->stepCount() << ".h5";
     simulation_->writeRestart((dir / name.str()).string());
+    {
+        // What the engine's restart file does not know: the insertion progress.
+        std::ofstream state((dir / name.str()).string() + ".runner");
+        state << std::setprecision(17) << insertionsDone_ << " " << placed_ << " " << nextWaveTime_ << "\n";
+    }
     const fs::path pointer = dir / "latest";
     {
         std::ofstream out(pointer.string() + ".writing");

@@ -192,6 +192,10 @@ std::vector<InsertionSpec> readInsertions(const Dictionary& root, const CaseSetu
                                                      : std::string("settled");
         r.placement.settleDirection = packing == "settled" ? setup.settings.gravity : Vec3::Zero();
         r.placement.context = spec.context;
+        if (d.has("waveInterval")) {
+            spec.waveInterval = d.getPositive("waveInterval");
+            r.placement.whenFull = WhenRegionFull::PlaceWhatFits;
+        }
         out.push_back(std::move(spec));
     }
     return out;
@@ -337,18 +341,32 @@ std::unique_ptr<Simulation> makeSimulation(const CaseSetup& setup) {
     return std::make_unique<Simulation>(setup.settings, setup.materials, setup.interactions, setup.walls);
 }
 
-std::size_t performInsertion(Simulation& sim, const InsertionSpec& spec) {
+std::vector<double> drawPopulation(const InsertionSpec& spec) {
+    if (!spec.explicitParticles.empty()) {
+        std::vector<double> d;
+        for (const InsertedParticle& q : spec.explicitParticles) d.push_back(2.0 * q.radius);
+        return d;
+    }
+    const InsertionRequest& r = spec.request;
+    return r.targetMass > 0.0 ? drawDiametersForMass(*spec.distribution, r.targetMass, r.density, r.placement.seed)
+                              : drawDiametersForCount(*spec.distribution, r.targetCount, r.placement.seed);
+}
+
+std::size_t performInsertion(Simulation& sim, const InsertionSpec& spec, const std::vector<double>& diameters,
+                             std::size_t first) {
     if (!spec.explicitParticles.empty()) {
         sim.insert(spec.explicitParticles, spec.materialIndex, spec.request.initialVelocity, spec.context);
         return spec.explicitParticles.size();
     }
-    InsertionRequest request = spec.request;
+    PlacementOptions placement = spec.request.placement;
     const ParticleStore& p = sim.particles();
-    request.placement.existing.positions = &p.position;
-    request.placement.existing.radii = &p.radius;
+    placement.existing.positions = &p.position;
+    placement.existing.radii = &p.radius;
+    // Each wave draws its own jitter and site order, reproducibly.
+    placement.seed += first;
     const double time = sim.time();
     const std::vector<Wall>& walls = sim.walls();
-    request.placement.clearance = [&walls, time](const Vec3& x, double r) {
+    placement.clearance = [&walls, time](const Vec3& x, double r) {
         std::vector<WallContact> touching;
         for (const Wall& w : walls) {
             if (!w.isActive(time)) continue;
@@ -359,8 +377,9 @@ std::size_t performInsertion(Simulation& sim, const InsertionSpec& spec) {
         }
         return true;
     };
-    const std::vector<InsertedParticle> placed = insertParticles(*spec.region, *spec.distribution, request);
-    sim.insert(placed, spec.materialIndex, request.initialVelocity, spec.context);
+    const std::vector<double> remaining(diameters.begin() + static_cast<long>(first), diameters.end());
+    const std::vector<InsertedParticle> placed = placeParticles(*spec.region, remaining, placement);
+    sim.insert(placed, spec.materialIndex, spec.request.initialVelocity, spec.context);
     return placed.size();
 }
 

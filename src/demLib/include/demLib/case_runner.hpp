@@ -42,6 +42,7 @@ private:
     void writeSummaryHeader();
     void writeSummaryLine();
     void writeRestart();
+    void readRunnerState(const std::string& restartFile);
     void progress(bool force);
 
     CaseSetup setup_;
@@ -51,6 +52,10 @@ private:
     std::unique_ptr<FieldOutput> fields_;
     std::ofstream summary_;
     std::size_t insertionsDone_ = 0;
+    // The block being inserted in waves: its population and how much is placed.
+    std::vector<double> population_;
+    std::size_t placed_ = 0;
+    double nextWaveTime_ = 0.0;
     long nextField_ = 0, nextLog_ = 0, nextRestart_ = 0;  // interval counters
     long lastFieldStep_ = -1, lastLogStep_ = -1, lastRestartStep_ = -1;
     double startTime_ = 0.0;

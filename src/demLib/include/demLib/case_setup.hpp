@@ -28,6 +28,9 @@ struct InsertionSpec {
     InsertionRequest request;
     // Particles listed explicitly ('positions' + 'diameter'), placed as given.
     std::vector<InsertedParticle> explicitParticles;
+    // > 0: a population larger than the region holds at once is inserted in
+    // waves this far apart in time (each wave fills the free lattice sites).
+    double waveInterval = 0.0;
     std::string context;  // "file: insertion/<name>" for messages
 };
 
@@ -71,9 +74,18 @@ CaseSetup readCaseSetup(const Dictionary& dict, const std::string& caseDir);
 // Builds the simulation of a case (no particles inserted yet).
 std::unique_ptr<Simulation> makeSimulation(const CaseSetup& setup);
 
-// Draws and places the particles of one insertion block, avoiding the
-// particles already in `simulation` and its walls, then inserts them.
-std::size_t performInsertion(Simulation& simulation, const InsertionSpec& spec);
+// The diameters of an insertion block's whole population (deterministic from its seed).
+std::vector<double> drawPopulation(const InsertionSpec& spec);
+
+// Places diameters[first...] in the block's region, avoiding the particles
+// already in `simulation` and its walls, and inserts them.  Returns how many
+// were placed: all of them, or (with a wave interval) those that fit now.
+std::size_t performInsertion(Simulation& simulation, const InsertionSpec& spec,
+                             const std::vector<double>& diameters, std::size_t first = 0);
+// The whole population at once.
+inline std::size_t performInsertion(Simulation& simulation, const InsertionSpec& spec) {
+    return performInsertion(simulation, spec, drawPopulation(spec));
+}
 
 // Mass of the particles whose centre lies in `region`.
 double massInRegion(const ParticleStore& particles, const Region& region);
