@@ -69,6 +69,7 @@ struct BoxCase {
     dem::RollingModel rolling = dem::RollingModel::EPSD2;
     double rollingFriction = 0.1;
     Vec3 floorVelocity = Vec3::Zero();
+    Vec3 initialVelocity = Vec3::Zero();
     std::uint64_t seed = 11;
 };
 
@@ -117,7 +118,7 @@ dem::Simulation makeBox(const BoxCase& c) {
     request.placement.gapFraction = 0.05;
     request.placement.settleDirection = Vec3(0, 0, -1);
     sim.insert(dem::insertParticles(dem::Region::box(Vec3::Zero(), Vec3(W, W, H)), psd, request), 0,
-               Vec3::Zero(), "bed insertion");
+               c.initialVelocity, "bed insertion");
     return sim;
 }
 
@@ -306,12 +307,13 @@ BoxCase restartCase() {
     c.height = 0.03;
     c.count = 150;
     c.floorVelocity = Vec3(0.02, 0.0, 0.0);
+    c.initialVelocity = Vec3(0.0, 0.0, -0.3);  // thrown down: a dense heap within 4000 steps
     c.seed = 5;
     return c;
 }
 
-constexpr long kStepsBefore = 8000;  // fall and land: contacts everywhere at the restart
-constexpr long kStepsAfter = 3000;
+constexpr long kStepsBefore = 4000;  // fall and land: contacts everywhere at the restart
+constexpr long kStepsAfter = 1500;
 
 void checkRepeatAndRestart(int threadCount) {
     ThreadCount threads(threadCount);
@@ -331,6 +333,9 @@ void checkRepeatAndRestart(int threadCount) {
     }
     EXPECT_GT(rollingHistory, 0.0);
     EXPECT_GT(shearHistory, 0.0);
+    std::printf("restart point (%d threads): %zu touching pairs, %zu wall contacts, max |rolling torque| %.3e N m\n",
+                threadCount, first.lastStep().contacts.touchingPairs, first.lastStep().contacts.wallContacts,
+                rollingHistory);
     first.writeRestart(path);
     first.step(kStepsAfter);
 

@@ -3,6 +3,10 @@
 // the engine's refusal of bad input.  Every expected number is a closed form.
 #include <gtest/gtest.h>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -17,6 +21,28 @@
 namespace {
 
 using dem::Vec3;
+
+// These tests check physics, not threading: one thread, so that they run
+// alike (and fast) whatever OMP_NUM_THREADS says.  Restored afterwards.
+class OneThread {
+public:
+    OneThread() {
+#ifdef _OPENMP
+        saved_ = omp_get_max_threads();
+        omp_set_num_threads(1);
+#endif
+    }
+    ~OneThread() {
+#ifdef _OPENMP
+        omp_set_num_threads(saved_);
+#endif
+    }
+    OneThread(const OneThread&) = delete;
+    OneThread& operator=(const OneThread&) = delete;
+
+private:
+    int saved_ = 1;
+};
 
 // A soft "glass" (E reduced as usual in DEM): R = 1 mm gives a Rayleigh time
 // of 1.22e-4 s and a 1 m/s pair impact of 2.7e-4 s.
@@ -103,6 +129,7 @@ double wallRestitution(double e, double v, double dt) {
 }
 
 TEST(EngineCollisions, PairRestitutionMatchesInputWithinOnePercent) {
+    OneThread oneThread;
     const double dt = 1e-6;
     for (double e : {0.1, 0.5, 0.9}) {
         const double measured = pairRestitution(e, 1.0, dt);
@@ -112,6 +139,7 @@ TEST(EngineCollisions, PairRestitutionMatchesInputWithinOnePercent) {
 }
 
 TEST(EngineCollisions, WallRestitutionMatchesInputWithinOnePercent) {
+    OneThread oneThread;
     const double dt = 1e-6;
     for (double e : {0.1, 0.5, 0.9}) {
         const double measured = wallRestitution(e, 1.0, dt);
@@ -123,6 +151,7 @@ TEST(EngineCollisions, WallRestitutionMatchesInputWithinOnePercent) {
 // Hertz with the Tsuji dashpot gives an e that does not depend on the impact
 // speed: a linear (constant-stiffness) dashpot would not.
 TEST(EngineCollisions, RestitutionIndependentOfImpactSpeed) {
+    OneThread oneThread;
     const double slow = pairRestitution(0.5, 0.1, 2e-6);
     const double fast = pairRestitution(0.5, 2.0, 5e-7);
     std::printf("pair e=0.5: v=0.1 -> %.6f, v=2 -> %.6f\n", slow, fast);
@@ -161,6 +190,7 @@ double hertzEnergy(const dem::Simulation& sim) {
 }
 
 TEST(EngineCollisions, ElasticGasInClosedBoxConservesEnergy) {
+    OneThread oneThread;
     const std::vector<dem::Material> mats{glass()};
     dem::PairCoefficients c;
     c.restitution = 1.0;
@@ -234,6 +264,7 @@ TEST(EngineCollisions, ElasticGasInClosedBoxConservesEnergy) {
 // 7. Bad input.
 
 TEST(EngineInput, ParticleInsideWallIsRejectedNamingTheWall) {
+    OneThread oneThread;
     const std::vector<dem::Material> mats{glass()};
     dem::PairCoefficients c;
     c.restitution = 0.5;
@@ -253,6 +284,7 @@ TEST(EngineInput, ParticleInsideWallIsRejectedNamingTheWall) {
 }
 
 TEST(EngineInput, NonPositiveRadiusIsRejected) {
+    OneThread oneThread;
     const std::vector<dem::Material> mats{glass()};
     dem::PairCoefficients c;
     dem::Simulation sim(noGravity(1e-6), mats, tableFor(mats, c), {});
@@ -269,6 +301,7 @@ TEST(EngineInput, NonPositiveRadiusIsRejected) {
 }
 
 TEST(EngineInput, TooLargeTimeStepIsRejectedNamingBothValues) {
+    OneThread oneThread;
     const std::vector<dem::Material> mats{glass()};
     dem::PairCoefficients c;
     const double rayleigh = dem::rayleighTime(kRadius, 2500.0, 5e6, 0.3);
@@ -292,6 +325,7 @@ TEST(EngineInput, TooLargeTimeStepIsRejectedNamingBothValues) {
         EXPECT_NE(what.find(allowedText.str()), std::string::npos) << what << " lacks " << allowedText.str();
         EXPECT_NE(what.find("expected"), std::string::npos) << what;
     }
+    EXPECT_EQ(sim.particles().size(), 0u);  // a rejected insertion adds nothing
     // Just below the limit is accepted.
     dem::Simulation fine(noGravity(0.99 * allowed), mats, tableFor(mats, c), {});
     EXPECT_NO_THROW(fine.insert({{Vec3::Zero(), kRadius}}, 0, Vec3::Zero()));

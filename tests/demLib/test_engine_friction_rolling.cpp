@@ -4,6 +4,10 @@
 // distance of a sphere rolling against a constant resisting torque.
 #include <gtest/gtest.h>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -15,6 +19,28 @@
 namespace {
 
 using dem::Vec3;
+
+// These tests check physics, not threading: one thread, so that they run
+// alike (and fast) whatever OMP_NUM_THREADS says.  Restored afterwards.
+class OneThread {
+public:
+    OneThread() {
+#ifdef _OPENMP
+        saved_ = omp_get_max_threads();
+        omp_set_num_threads(1);
+#endif
+    }
+    ~OneThread() {
+#ifdef _OPENMP
+        omp_set_num_threads(saved_);
+#endif
+    }
+    OneThread(const OneThread&) = delete;
+    OneThread& operator=(const OneThread&) = delete;
+
+private:
+    int saved_ = 1;
+};
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kRadius = 1e-3;
@@ -107,6 +133,7 @@ SlideOnset slideOnset(double mu) {
 }
 
 TEST(EngineFriction, BlockedSphereSlidesAtArctanMu) {
+    OneThread oneThread;
     for (double mu : {0.3, 0.61}) {
         const SlideOnset onset = slideOnset(mu);
         const double expected = std::atan(mu) * 180.0 / kPi;
@@ -153,6 +180,7 @@ double stopDistanceRatio(dem::RollingModel model, double rollingFriction, double
 }
 
 TEST(EngineRolling, Epsd2StopsAtAnalyticDistance) {
+    OneThread oneThread;
     for (auto [muR, v0] : {std::pair{0.1, 0.1}, std::pair{0.5, 0.2}}) {
         const double ratio = stopDistanceRatio(dem::RollingModel::EPSD2, muR, v0);
         std::printf("EPSD2 mu_r %.2f v0 %.2f: s / s_analytic = %.5f\n", muR, v0, ratio);
@@ -161,6 +189,7 @@ TEST(EngineRolling, Epsd2StopsAtAnalyticDistance) {
 }
 
 TEST(EngineRolling, CdtStopsAtAnalyticDistance) {
+    OneThread oneThread;
     for (auto [muR, v0] : {std::pair{0.1, 0.1}, std::pair{0.5, 0.2}}) {
         const double ratio = stopDistanceRatio(dem::RollingModel::CDT, muR, v0);
         std::printf("CDT   mu_r %.2f v0 %.2f: s / s_analytic = %.5f\n", muR, v0, ratio);
@@ -171,6 +200,7 @@ TEST(EngineRolling, CdtStopsAtAnalyticDistance) {
 // Without rolling resistance the sphere keeps rolling: v stays v0 (a wrong
 // torque sign or lever arm would slow it or make it slip).
 TEST(EngineRolling, NoResistanceKeepsRolling) {
+    OneThread oneThread;
     const double dt = 1e-5;
     const double v0 = 0.1;
     dem::Simulation sim = sphereOnFloor(0.61, 0.0, dem::RollingModel::None, Vec3(0, 0, -kG), dt, 0.05);

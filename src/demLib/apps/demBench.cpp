@@ -1,6 +1,6 @@
 // demBench: the performance benchmark driver of bench/run (issue 7).
 //
-//   demBench settle -case DIR -out PREFIX [-threads N] [-placement rsa|lattice]
+//   demBench settle -case DIR -out PREFIX [-threads N] [-placement rsa|lattice|bed [-bed FILE]]
 //                   [-packing PHI] [-gravityFactor G] [-settleTime T] [-relaxTime T]
 //                   [-speedTolerance V]
 //       Builds the bed of DIR/constant/demProperties (its first insertion
@@ -162,9 +162,31 @@ double rmsSpeed(const dem::ParticleStore& p) {
     return p.empty() ? 0.0 : std::sqrt(s / p.size());
 }
 
-std::vector<dem::InsertedParticle> currentBed(const dem::ParticleStore& p) {
+// The settled bed rests on the walls with micrometre overlaps, which
+// Simulation::insert rejects (and read_data would turn into a kick): move each
+// particle along the wall normals until it just touches.  The shift is the
+// elastic overlap, ~1e-3 of a radius.
+std::vector<dem::InsertedParticle> currentBed(const dem::ParticleStore& p, const std::vector<dem::Wall>& walls,
+                                              double time) {
     std::vector<dem::InsertedParticle> bed(p.size());
-    for (std::size_t i = 0; i < p.size(); ++i) bed[i] = {p.position[i], p.radius[i]};
+    std::vector<dem::WallContact> touching;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        bed[i] = {p.position[i], p.radius[i]};
+        for (int pass = 0; pass < 3; ++pass) {
+            bool moved = false;
+            for (const dem::Wall& w : walls) {
+                if (!w.isActive(time)) continue;
+                touching.clear();
+                w.findContacts(bed[i].position, bed[i].radius, time, touching);
+                for (const dem::WallContact& c : touching)
+                    if (c.overlap > 0.0) {
+                        bed[i].position += c.overlap * c.normal;
+                        moved = true;
+                    }
+            }
+            if (!moved) break;
+        }
+    }
     return bed;
 }
 
@@ -188,6 +210,22 @@ double settleFor(dem::Simulation& sim, double time, double tolerance, const std:
     return done * sim.timeStep();
 }
 
+std::vector<dem::InsertedParticle> readBed(const std::string& file) {
+    std::ifstream in(file);
+    if (!in) throw dem::InputError("demBench: cannot open bed file '" + file + "'");
+    std::vector<dem::InsertedParticle> bed;
+    std::string line;
+    while (std::getline(in, line)) {
+        if (line.empty() || line[0] == '#') continue;
+        std::istringstream s(line);
+        dem::InsertedParticle q;
+        if (!(s >> q.position.x() >> q.position.y() >> q.position.z() >> q.radius))
+            throw dem::InputError("demBench: bed file '" + file + "': expected 'x y z radius' in line '" + line + "'");
+        bed.push_back(q);
+    }
+    return bed;
+}
+
 int settle(const Options& o) {
     const std::string caseDir = o.get("case");
     const std::string out = o.get("out");
@@ -205,8 +243,10 @@ int settle(const Options& o) {
                     dem::Vec3::Zero(), spec.context);
     } else if (placement == "lattice") {
         dem::performInsertion(*sim, spec);
+    } else if (placement == "bed") {  // continue settling a stored bed
+        sim->insert(readBed(o.get("bed")), spec.materialIndex, dem::Vec3::Zero(), "bed");
     } else {
-        throw dem::InputError("demBench: -placement expects 'rsa' or 'lattice'");
+        throw dem::InputError("demBench: -placement expects 'rsa', 'lattice' or 'bed'");
     }
     std::cout << "settle: " << sim->particles().size() << " particles placed (" << placement << ")" << std::endl;
     const double tolerance = o.number("speedTolerance", 2e-3);
@@ -214,38 +254,22 @@ int settle(const Options& o) {
 
     // Relax under the true gravity from rest, then store.
     std::unique_ptr<dem::Simulation> relaxed = dem::makeSimulation(setup);
-    relaxed->insert(currentBed(sim->particles()), spec.materialIndex, dem::Vec3::Zero(), spec.context);
+    relaxed->insert(currentBed(sim->particles(), sim->walls(), sim->time()), spec.materialIndex, dem::Vec3::Zero(), spec.context);
     sim.reset();
     settleFor(*relaxed, o.number("relaxTime", 0.01), tolerance, "relax");
 
-    const dem::ParticleStore& p = relaxed->particles();
+    const std::vector<dem::InsertedParticle> settled =
+        currentBed(relaxed->particles(), relaxed->walls(), relaxed->time());
     std::ofstream bed(out + ".bed");
-    bed << "# demBench settled bed: x y z radius [m]; " << p.size() << " particles, coordination "
+    bed << "# demBench settled bed: x y z radius [m]; " << settled.size() << " particles, coordination "
         << relaxed->coordinationNumber() << "\n";
     bed << std::setprecision(17);
-    for (std::size_t i = 0; i < p.size(); ++i)
-        bed << p.position[i].x() << ' ' << p.position[i].y() << ' ' << p.position[i].z() << ' ' << p.radius[i]
-            << '\n';
+    for (const dem::InsertedParticle& q : settled)
+        bed << q.position.x() << ' ' << q.position.y() << ' ' << q.position.z() << ' ' << q.radius << '\n';
     if (!bed) throw dem::RuntimeError("demBench: cannot write '" + out + ".bed'");
     relaxed->writeRestart(out + ".restart.h5");
     std::cout << "settle: wrote " << out << ".bed and " << out << ".restart.h5" << std::endl;
     return 0;
-}
-
-std::vector<dem::InsertedParticle> readBed(const std::string& file) {
-    std::ifstream in(file);
-    if (!in) throw dem::InputError("demBench: cannot open bed file '" + file + "'");
-    std::vector<dem::InsertedParticle> bed;
-    std::string line;
-    while (std::getline(in, line)) {
-        if (line.empty() || line[0] == '#') continue;
-        std::istringstream s(line);
-        dem::InsertedParticle q;
-        if (!(s >> q.position.x() >> q.position.y() >> q.position.z() >> q.radius))
-            throw dem::InputError("demBench: bed file '" + file + "': expected 'x y z radius' in line '" + line + "'");
-        bed.push_back(q);
-    }
-    return bed;
 }
 
 int timeSteps(const Options& o) {
@@ -312,7 +336,8 @@ int timeSteps(const Options& o) {
 }
 
 void usage(std::ostream& out) {
-    out << "Usage: demBench settle -case DIR -out PREFIX [-threads N] [-placement rsa|lattice] [-packing PHI]\n"
+    out << "Usage: demBench settle -case DIR -out PREFIX [-threads N] [-placement rsa|lattice|bed -bed FILE]\n"
+           "                       [-packing PHI]\n"
            "                       [-gravityFactor G] [-settleTime T] [-relaxTime T] [-speedTolerance V]\n"
            "       demBench time -case DIR -bed FILE -steps K [-threads N] [-sample S]\n"
            "Benchmark driver of bench/run; see docs/performance.md.\n";

@@ -1,5 +1,7 @@
 #include "demLib/contact_force_kernel.hpp"
 
+#include "demLib/parallel.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -10,14 +12,6 @@
 namespace dem {
 
 namespace {
-
-int maxThreads() {
-#ifdef _OPENMP
-    return omp_get_max_threads();
-#else
-    return 1;
-#endif
-}
 
 int threadIndex() {
 #ifdef _OPENMP
@@ -37,7 +31,7 @@ public:
                               ParticleWallContacts& wallContacts, const std::vector<Wall>& walls,
                               const InteractionTable& interactions, double time, double dt) override {
         const int n = static_cast<int>(p.size());
-        const int threads = std::max(1, std::min(maxThreads(), n / 64 + 1));
+        const int threads = threadsFor(n, heavyLoopParticlesPerThread);
         // Thread 0 accumulates into the particle arrays; the others into their own
         // buffers, added afterwards in thread order: the sums, and so the results,
         // are the same in every run with the same thread count.
@@ -71,7 +65,7 @@ public:
             wallCount += newWall[t].size();
         }
         for (int t = 1; t < threads; ++t) {
-#pragma omp parallel for schedule(static) num_threads(threads)
+#pragma omp parallel for schedule(static) num_threads(threadsFor(n, lightLoopParticlesPerThread))
             for (int i = 0; i < n; ++i) {
                 p.force[i] += buffers_[t].force[i];
                 p.torque[i] += buffers_[t].torque[i];

@@ -1,11 +1,13 @@
 #include "demLib/integrator.hpp"
 
+#include "demLib/parallel.hpp"
+
 namespace dem {
 
 void kickAndDrift(ParticleStore& p, double dt) {
     const double half = 0.5 * dt;
     const std::size_t n = p.size();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) num_threads(threadsFor(n, lightLoopParticlesPerThread))
     for (std::size_t i = 0; i < n; ++i) {
         p.velocity[i] += (half * p.invMass[i]) * p.force[i];
         p.omega[i] += (half * p.invInertia[i]) * p.torque[i];
@@ -16,7 +18,7 @@ void kickAndDrift(ParticleStore& p, double dt) {
 void kick(ParticleStore& p, double dt) {
     const double half = 0.5 * dt;
     const std::size_t n = p.size();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) num_threads(threadsFor(n, lightLoopParticlesPerThread))
     for (std::size_t i = 0; i < n; ++i) {
         p.velocity[i] += (half * p.invMass[i]) * p.force[i];
         p.omega[i] += (half * p.invInertia[i]) * p.torque[i];

@@ -1,5 +1,7 @@
 #include "demLib/particle_particle_neighbor_list.hpp"
 
+#include "demLib/parallel.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -11,14 +13,6 @@
 namespace dem {
 
 namespace {
-
-int threadCount() {
-#ifdef _OPENMP
-    return omp_get_max_threads();
-#else
-    return 1;
-#endif
-}
 
 }  // namespace
 
@@ -32,7 +26,7 @@ bool ParticleParticleNeighborList::needsRebuild(const ParticleStore& particles) 
     const double limit2 = 0.25 * skin_ * skin_;
     const std::size_t n = particles.size();
     bool rebuild = false;
-#pragma omp parallel for schedule(static) reduction(|| : rebuild)
+#pragma omp parallel for schedule(static) reduction(|| : rebuild) num_threads(threadsFor(n, lightLoopParticlesPerThread))
     for (std::size_t i = 0; i < n; ++i)
         if ((particles.position[i] - positionAtBuild_[i]).squaredNorm() > limit2) rebuild = true;
     return rebuild;
@@ -121,7 +115,7 @@ void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
 
     // Each thread lists a contiguous block of i; blocks are joined in order, so
     // the list does not depend on the thread count.
-    const int threads = threadCount();
+    const int threads = threadsFor(n, heavyLoopParticlesPerThread);
     std::vector<std::vector<int>> blockNeighbors(threads);
     std::vector<int> count(n, 0);
     const double reach = skin_ + extraRange_;
@@ -174,7 +168,7 @@ void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
 
     if (!canTransfer) return;
     // Both lists are sorted by j within each i: merge to carry the pair state over.
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) num_threads(threadsFor(oldN, lightLoopParticlesPerThread))
     for (int i = 0; i < oldN; ++i) {
         int a = oldOffsets[i];
         const int aEnd = oldOffsets[i + 1];

@@ -7,6 +7,7 @@
 
 #include "demLib/error.hpp"
 #include "demLib/integrator.hpp"
+#include "demLib/parallel.hpp"
 
 namespace dem {
 
@@ -17,6 +18,20 @@ std::string formatVec(const Vec3& v) {
     s.precision(6);
     s << "(" << v.x() << " " << v.y() << " " << v.z() << ")";
     return s.str();
+}
+
+// Throws InputError when settings.timeStep exceeds `allowed` (unless the
+// settings allow a large time step), naming both values.
+void requireTimeStepBelow(const SimulationSettings& settings, double allowed, const std::string& context) {
+    if (settings.timeStep > allowed && !settings.allowLargeTimeStep) {
+        std::ostringstream s;
+        s << settings.source << ": keyword 'timeStep' = " << settings.timeStep << " s is larger than "
+          << settings.maxRayleighFraction << " x the Rayleigh time of the smallest particle (" << allowed
+          << " s allowed) after " << context
+          << "; expected timeStep <= " << allowed
+          << " (or set 'allowLargeTimeStep true' to override, at your own risk)";
+        throw InputError(s.str());
+    }
 }
 
 }  // namespace
@@ -71,11 +86,16 @@ void Simulation::insert(const std::vector<InsertedParticle>& inserted, int mater
             }
         }
     }
+    // The time step is checked before anything is added, so that a rejected
+    // insertion leaves the simulation as it was.
+    double allowed = maxAllowedTimeStep();
+    for (const InsertedParticle& q : inserted)
+        allowed = std::min(allowed, settings_.maxRayleighFraction * criticalTimeStep(materials_[materialIndex], q.radius));
+    requireTimeStepBelow(settings_, allowed, context);
     const double density = materials_[materialIndex].density;
     particles_.reserve(particles_.size() + inserted.size());
     for (const InsertedParticle& q : inserted)
         particles_.add(nextId_++, q.position, velocity, q.radius, density, materialIndex);
-    checkTimeStep(context);
     forcesValid_ = false;
 }
 
@@ -86,19 +106,6 @@ double Simulation::maxAllowedTimeStep() const {
         smallest = std::min(smallest, criticalTimeStep(m, particles_.radius[i]));
     }
     return settings_.maxRayleighFraction * smallest;
-}
-
-void Simulation::checkTimeStep(const std::string& context) const {
-    const double allowed = maxAllowedTimeStep();
-    if (settings_.timeStep > allowed && !settings_.allowLargeTimeStep) {
-        std::ostringstream s;
-        s << settings_.source << ": keyword 'timeStep' = " << settings_.timeStep << " s is larger than "
-          << settings_.maxRayleighFraction << " x the Rayleigh time of the smallest particle (" << allowed
-          << " s allowed) after " << context
-          << "; expected timeStep <= " << allowed
-          << " (or set 'allowLargeTimeStep true' to override, at your own risk)";
-        throw InputError(s.str());
-    }
 }
 
 void Simulation::setWaterContent(double w) {
@@ -200,7 +207,7 @@ void Simulation::redistributeLiquid() {
 void Simulation::computeForces() {
     const std::size_t n = particles_.size();
     const Vec3 g = settings_.gravity;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) num_threads(threadsFor(n, lightLoopParticlesPerThread))
     for (std::size_t i = 0; i < n; ++i) {
         particles_.force[i] = particles_.mass[i] * g + particles_.externalForce[i];
         particles_.torque[i].setZero();

@@ -107,7 +107,6 @@ public:
     void readRestart(const std::string& path);
 
 private:
-    void checkTimeStep(const std::string& context) const;
     void removeLostParticles();
     void updatePairList();
     void redistributeLiquid();
