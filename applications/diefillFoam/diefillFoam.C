@@ -7,24 +7,30 @@ Application
 
 Description
     Transient solver for the air in a die-filling process, coupled to the DEM
-    engine demLib.
+    engine demLib by unresolved (volume-averaged) drag.
 
-    The air is incompressible and Newtonian; laminar by default, with the
-    OpenFOAM turbulence framework available (constant/turbulenceProperties).
-    Pressure-velocity coupling: PIMPLE (controls in system/fvSolution).
-    The DEM side of the coupling lives in demCoupling.H.
+    The air is incompressible and Newtonian; its volume-averaged equations
+    carry the void fraction of the powder (model A or B of Zhou et al. 2010);
+    laminar by default, with the OpenFOAM turbulence framework available
+    (constant/turbulenceProperties).  Pressure-velocity coupling: PIMPLE.
+    Each fluid step the DEM takes deltaT/demTimeStep steps; void fraction and
+    drag are exchanged once per fluid step (docs/coupling.md).
 
-    Required fields
-        U   | Air velocity [m/s]
-        p   | Kinematic pressure, p/rho [m2/s2]
+    Case files
+        constant/transportProperties | nu [m2/s], rho [kg/m3] of the air
+        constant/couplingProperties  | coupling models (docs/coupling.md)
+        constant/demProperties       | the DEM (docs/case-reference.md)
+        0/U, 0/p                     | interstitial velocity, p/rho
+        0/alpha.air                  | optional: void-fraction BCs
 
 \*---------------------------------------------------------------------------*/
 
 #include "fvCFD.H"
 #include "singlePhaseTransportModel.H"
-#include "turbulentTransportModel.H"
+#include "PhaseIncompressibleTurbulenceModel.H"
 #include "pimpleControl.H"
 #include "fvOptions.H"
+#include "zeroGradientFvPatchFields.H"
 
 #include "demCoupling.H"
 
@@ -35,7 +41,8 @@ int main(int argc, char *argv[])
     argList::addNote
     (
         "Transient solver for the air in powder die filling,"
-        " coupled to the DEM engine demLib."
+        " coupled to the DEM engine demLib by unresolved drag"
+        " (constant/couplingProperties, constant/demProperties)."
     );
 
     #include "postProcess.H"
@@ -46,14 +53,15 @@ int main(int argc, char *argv[])
     #include "createMesh.H"
     #include "createControl.H"
     #include "createTimeControls.H"
-    #include "initContinuityErrs.H"
     #include "createFields.H"
     #include "CourantNo.H"
     #include "setInitialDeltaT.H"
 
     turbulence->validate();
 
-    diefill::demCoupling dem(mesh);
+    // Forces for the first DEM interval, from the initial air state
+    coupling.updateExchange(Ksp, KUp);
+    coupling.updateParticleForces(Ksp, KUp);
 
     // * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * //
 
@@ -68,6 +76,18 @@ int main(int argc, char *argv[])
         ++runTime;
 
         Info<< "Time = " << runTime.timeName() << nl << endl;
+
+        // --- Particles to the new time, then their volume and drag to the air
+        coupling.evolve();
+        coupling.updateVoidFraction();
+        alphaf = fvc::interpolate(alpha);
+        alphaPhi = alphaf*phi;
+        if (coupling.modelA())
+        {
+            alphaP = alpha;
+            alphaPf = alphaf;
+        }
+        coupling.updateExchange(Ksp, KUp);
 
         // --- Pressure-velocity PIMPLE corrector loop
         while (pimple.loop())
@@ -87,10 +107,15 @@ int main(int argc, char *argv[])
             }
         }
 
+        // --- The air's new state to the particles for the next DEM interval
+        coupling.updateParticleForces(Ksp, KUp);
+
         runTime.write();
 
         runTime.printExecutionTime(Info);
     }
+
+    coupling.finish();
 
     Info<< "End\n" << endl;
 

@@ -1,0 +1,41 @@
+#include "centreVoidFraction.H"
+#include "addToRunTimeSelectionTable.H"
+
+namespace Foam
+{
+namespace diefill
+{
+    defineTypeNameAndDebug(centreVoidFraction, 0);
+    addToRunTimeSelectionTable(voidFractionModel, centreVoidFraction, dictionary);
+}
+}
+
+Foam::diefill::centreVoidFraction::centreVoidFraction
+(
+    const fvMesh& mesh,
+    const dictionary& coeffs
+)
+:
+    voidFractionModel(mesh, coeffs)
+{}
+
+
+void Foam::diefill::centreVoidFraction::distribute
+(
+    const point& centre,
+    scalar radius,
+    DynamicList<label>& cells,
+    DynamicList<scalar>& weights
+) const
+{
+    if (outsideLocalBounds(centre, 0))
+    {
+        return;
+    }
+    const label celli = mesh_.findCell(centre);
+    if (celli >= 0)
+    {
+        cells.append(celli);
+        weights.append(1);
+    }
+}

@@ -1,0 +1,102 @@
+#include "dividedVoidFraction.H"
+#include "addToRunTimeSelectionTable.H"
+
+namespace Foam
+{
+namespace diefill
+{
+    defineTypeNameAndDebug(dividedVoidFraction, 0);
+    addToRunTimeSelectionTable(voidFractionModel, dividedVoidFraction, dictionary);
+}
+}
+
+Foam::diefill::dividedVoidFraction::dividedVoidFraction
+(
+    const fvMesh& mesh,
+    const dictionary& coeffs
+)
+:
+    voidFractionModel(mesh, coeffs)
+{
+    const label n = coeffs.getOrDefault<label>("pointsPerDiameter", 4);
+    if (n < 2)
+    {
+        FatalIOErrorInFunction(coeffs)
+            << "pointsPerDiameter must be at least 2, got " << n
+            << exit(FatalIOError);
+    }
+
+    // Lattice points at -1 + (i + 1/2) 2/n in each direction of the unit cube
+    // around the unit sphere; keep those inside.
+    DynamicList<vector> pts;
+    const scalar h = 2.0/n;
+    for (label i = 0; i < n; ++i)
+    {
+        for (label j = 0; j < n; ++j)
+        {
+            for (label k = 0; k < n; ++k)
+            {
+                const vector x
+                (
+                    -1 + (i + 0.5)*h,
+                    -1 + (j + 0.5)*h,
+                    -1 + (k + 0.5)*h
+                );
+                if (magSqr(x) <= 1)
+                {
+                    pts.append(x);
+                }
+            }
+        }
+    }
+    unitPoints_.transfer(pts);
+
+    Info<< "        " << unitPoints_.size() << " satellite points per particle"
+        << endl;
+}
+
+
+void Foam::diefill::dividedVoidFraction::distribute
+(
+    const point& centre,
+    scalar radius,
+    DynamicList<label>& cells,
+    DynamicList<scalar>& weights
+) const
+{
+    if (outsideLocalBounds(centre, radius))
+    {
+        return;
+    }
+
+    const scalar share = 1.0/unitPoints_.size();
+    label hint = mesh_.findCell(centre);
+    const label first = cells.size();
+
+    for (const vector& u : unitPoints_)
+    {
+        const label celli = findCell(centre + radius*u, hint);
+        if (celli < 0)
+        {
+            continue;
+        }
+        hint = celli;
+
+        // Merge with an entry of the same cell (few cells per particle)
+        bool merged = false;
+        for (label k = first; k < cells.size(); ++k)
+        {
+            if (cells[k] == celli)
+            {
+                weights[k] += share;
+                merged = true;
+                break;
+            }
+        }
+        if (!merged)
+        {
+            cells.append(celli);
+            weights.append(share);
+        }
+    }
+}
