@@ -76,11 +76,6 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
 
     if (restart.empty()) {
         performDueInsertions();
-        if (setup_.waterContent > 0.0) {
-            simulation_->setWaterContent(setup_.waterContent);
-            log_ << "Water content " << setup_.waterContent << ": " << simulation_->liquid().totalVolume
-                 << " m^3 of liquid\n";
-        }
         writeDueOutput(true);
     }
     wallStart_ = lastProgress_ = std::chrono::steady_clock::now();
@@ -125,6 +120,12 @@ void CaseRunner::performDueInsertions() {
         placed_ += n;
         log_ << "Inserted " << n << " particles (" << mass * 1e3 << " g) of '" << spec.name << "' at t = " << now
              << " s";
+        if (setup_.waterContent > 0.0 && n > 0) {
+            // The water belongs to the dry mass now present: w m_dry of liquid,
+            // shared out again at the next contact-list update.
+            simulation_->setWaterContent(setup_.waterContent);
+            log_ << ", liquid now " << simulation_->liquid().totalVolume << " m^3 (w = " << setup_.waterContent << ")";
+        }
         if (placed_ < population_.size()) {
             if (n == 0 && simulation_->particles().size() == before && spec.waveInterval <= 0.0)
                 throw InputError(spec.context + ": no particle fits in the region");
