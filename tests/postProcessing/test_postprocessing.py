@@ -1,0 +1,318 @@
+"""Tests of tools/diefillpost on synthetic data with known answers (see run)."""
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+
+ROOT = sys.argv[1] if len(sys.argv) > 1 else os.path.abspath(os.path.join(os.path.dirname(__file__), "../.."))
+sys.path.insert(0, os.path.join(ROOT, "tools"))
+import h5py  # noqa: E402
+
+from diefillpost import foamdict, geometry, plate, plots, profile, results, series, summary  # noqa: E402
+
+PASSED, FAILED = 0, 0
+TMP = tempfile.mkdtemp(prefix="diefillpost_")
+
+
+def check(name, ok, detail=""):
+    global PASSED, FAILED
+    if ok:
+        PASSED += 1
+        print(f"PASS: {name} {detail}")
+    else:
+        FAILED += 1
+        print(f"FAIL: {name} {detail}")
+
+
+def test(fn):
+    try:
+        fn()
+    except Exception as e:  # a crashing test is a failed test
+        check(fn.__name__, False, f"raised {type(e).__name__}: {e}")
+    return fn
+
+
+def cone_particles(angle_deg, height, r_particle, rng, base_z=0.0, centre=(0.0, 0.0)):
+    """Spheres filling a cone (apex up) whose surface h(rho) = height - tan(a) rho; the
+    outermost layer touches the surface (top = centre + radius on it)."""
+    slope = np.tan(np.radians(angle_deg))
+    R = height / slope
+    pts = []
+    # surface layer: tops exactly on the cone surface
+    n_surface = int(4 * np.pi * R**2 / r_particle**2)
+    rho = R * np.sqrt(rng.random(n_surface))
+    phi = 2 * np.pi * rng.random(n_surface)
+    top = height - slope * rho
+    pts.append(np.column_stack([centre[0] + rho * np.cos(phi), centre[1] + rho * np.sin(phi), base_z + top - r_particle]))
+    # interior: centres well below the surface
+    n_in = n_surface
+    rho = R * np.sqrt(rng.random(n_in))
+    phi = 2 * np.pi * rng.random(n_in)
+    z = (height - slope * rho) * rng.random(n_in) - 2 * r_particle
+    pts.append(np.column_stack([centre[0] + rho * np.cos(phi), centre[1] + rho * np.sin(phi), base_z + z]))
+    p = np.vstack(pts)
+    return p[p[:, 2] >= base_z + r_particle * 0.0 - 10]  # keep all; tests only use the max per bin
+
+
+@test
+def cone_angle_is_recovered():
+    rng = np.random.default_rng(1)
+    for angle in (20.0, 28.0, 35.0):
+        p = cone_particles(angle, 0.02, 5e-4, rng)
+        r, h, n = profile.radial_profile(p, 5e-4, (0, 0, 0), (0, 0, 1), bin_width=1e-3, sectors=8)
+        fit = profile.fit_line(r, h, profile.flank_window(r, h, 0.2, 0.8))
+        check(f"cone {angle:g} deg: fitted angle within 0.5 deg", abs(fit["angle"] - angle) < 0.5,
+              f"(got {fit['angle']:.3f}, window {fit['window'][0]*1e3:.1f}-{fit['window'][1]*1e3:.1f} mm)")
+
+
+@test
+def tilted_axis_cone():
+    # the same cone about an axis tilted 20 deg from z, built in the axis frame and rotated
+    rng = np.random.default_rng(2)
+    p = cone_particles(30.0, 0.015, 4e-4, rng)
+    R = geometry.rotation_matrix((1, 0, 0), np.radians(20))
+    origin = np.array([0.01, -0.02, 0.005])
+    pw = p @ R.T + origin
+    r, h, _ = profile.radial_profile(pw, 4e-4, origin, R @ np.array([0, 0, 1.0]), bin_width=8e-4)
+    fit = profile.fit_line(r, h, profile.flank_window(r, h))
+    check("cone about a tilted, shifted axis: 30 deg within 0.5 deg", abs(fit["angle"] - 30) < 0.5, f"(got {fit['angle']:.3f})")
+
+
+@test
+def profile_heights_are_tops():
+    # one particle per 1 mm bin, centre height 2x mm + radius offsets: max top per bin exact
+    x = np.arange(20) * 1e-3 + 0.5e-3
+    radius = np.full(20, 2e-4)
+    z = 0.003 + 0.5 * x
+    extra = np.column_stack([x, np.zeros(20), z - 1e-3])  # lower particles that must not count
+    pos = np.vstack([np.column_stack([x, np.zeros(20), z]), extra])
+    c, h = profile.line_profile(pos, np.concatenate([radius, radius]), (0, 0, 0), (1, 0, 0), (0, 0, 1), 1e-3, extent=(0, 0.02))
+    check("line profile: max top per bin", np.allclose(h, z + 2e-4, atol=1e-12), f"(max err {np.max(np.abs(h - z - 2e-4)):.2e})")
+    check("line profile: bin centres", np.allclose(c, x))
+    fit = profile.fit_line(c, h, (0, 0.02))
+    check("line fit: slope 0.5 -> 26.565 deg", abs(fit["angle"] - np.degrees(np.arctan(0.5))) < 1e-9 and abs(fit["intercept"] - 0.0032) < 1e-12)
+    band = profile.line_profile(pos + [0, 0.01, 0], np.concatenate([radius, radius]), (0, 0, 0), (1, 0, 0), (0, 0, 1), 1e-3,
+                                extent=(0, 0.02), band=0.005)[1]
+    check("line profile: band excludes particles off the line", np.all(np.isnan(band)))
+    try:
+        profile.fit_line(c[:2], h[:2], (0, 1))
+        check("fit needs 3 points", False)
+    except ValueError:
+        check("fit needs 3 points", True)
+
+
+@test
+def masses_in_regions():
+    # 4 x 4 x 4 grid of unit-density particles
+    g = np.stack(np.meshgrid(*[np.arange(4) * 1e-3] * 3, indexing="ij"), -1).reshape(-1, 3)
+    f = series.Frame.from_arrays(g, 1e-4, density=1000.0)
+    m1 = 1000.0 * 4 / 3 * np.pi * 1e-12
+    box = geometry.Box((-1e-4, -1e-4, -1e-4), (1.5e-3, 3.5e-3, 0.5e-3))  # x in {0,1}, y all, z {0}
+    check("mass in box: 8 particles", abs(geometry.mass_in_region(f, box) - 8 * m1) < 1e-18)
+    cyl = geometry.Cylinder((0, 0, 0), (0, 0, 1), 1.05e-3, -1e-4, 2.5e-3)  # (0,0),(1,0),(0,1) x z {0,1,2}
+    check("mass in cylinder: 9 particles", abs(geometry.mass_in_region(f, cyl) - 9 * m1) < 1e-18)
+    d = geometry.region_from_dict({"type": "cylinder", "axisPoint": [0, 0, 0], "axis": [0, 0, 2], "radius": 1.05e-3, "range": [-1e-4, 2.5e-3]})
+    check("region from a demProperties dict", abs(geometry.mass_in_region(f, d) - 9 * m1) < 1e-18)
+    check("fill ratio", np.allclose(summary.fill_ratio([0, 5, 10], 10.0), [0, 0.5, 1.0]))
+
+
+@test
+def dictionary_reader():
+    path = os.path.join(TMP, "dict")
+    with open(os.path.join(TMP, "inc"), "w") as f:
+        f.write("included 3;\n")
+    with open(path, "w") as f:
+        f.write('FoamFile { version 2.0; }\n/* block\n comment */ d 0.002; // line\n'
+                'm { a $d; v (1 2 -3e-1); w "q s"; l ((1 2) (3 4)); #include "inc" }\n'
+                'walls { p { type plane; motion { s1 { type rotate; start 0; end 1; angularVelocity 10; } } } }\n')
+    d = foamdict.read(path)
+    ok = (d["d"] == 0.002 and d["m"]["a"] == 0.002 and d["m"]["v"] == [1, 2, -0.3] and d["m"]["w"] == "q s"
+          and d["m"]["l"] == [[1, 2], [3, 4]] and d["m"]["included"] == 3 and "FoamFile" not in d
+          and d["walls"]["p"]["motion"]["s1"]["type"] == "rotate")
+    check("OpenFOAM dictionary subset: values, lists, $var, #include, comments", ok, str(d) if not ok else "")
+    case_dict = foamdict.read(os.path.join(ROOT, "tutorials/calibration/reposeAngle/constant/demProperties"))
+    check("reads the reposeAngle tutorial's demProperties", case_dict["walls"]["tube"]["radius"] == 0.0215)
+
+
+@test
+def wall_pose():
+    motion = {"a": {"type": "translate", "start": 0, "end": 1, "velocity": [0, 0, 0.1]},
+              "b": {"type": "rotate", "start": 1, "end": 2, "axisPoint": [0, 0, 0.1], "axis": [0, -1, 0], "angularVelocity": 30}}
+    w = geometry.WallPose(motion)
+    R, x0 = w.pose(2.0)
+    # point (1,0,0) of the reference: lifted by 0.1, then rotated 30 deg about -y through (0,0,0.1)
+    p = R @ np.array([1.0, 0, 0]) + x0
+    ok = np.allclose(p, [np.cos(np.radians(30)), 0, 0.1 + np.sin(np.radians(30))])
+    check("wall pose: translate then rotate about a hinge", ok, str(p))
+    check("rotation angle at mid-segment", abs(w.rotation_angle(1.5) - 15) < 1e-12 and w.rotation_angle(5) == 30)
+    check("to_reference inverts the pose", np.allclose(w.to_reference(p[None, :], 2.0), [[1, 0, 0]]))
+
+
+def write_case(case, props_text, frames_data, summary_rows, summary_header="time,step,particles,kineticEnergy,coordinationNumber,wallContacts,lostCount,lostMass"):
+    os.makedirs(os.path.join(case, "constant"), exist_ok=True)
+    os.makedirs(os.path.join(case, "dem"), exist_ok=True)
+    with open(os.path.join(case, "constant", "demProperties"), "w") as f:
+        f.write(props_text)
+    lines = []
+    for step, (t, pos, rad) in enumerate(frames_data):
+        name = f"particles_{step:09d}.h5"
+        n = len(pos)
+        with h5py.File(os.path.join(case, "dem", name), "w") as h:
+            h.attrs["time"] = t
+            h.attrs["step"] = step
+            h["id"] = np.arange(n, dtype=np.int64)
+            h["position"] = np.asarray(pos, float)
+            h["velocity"] = np.zeros((n, 3))
+            h["omega"] = np.zeros((n, 3))
+            h["force"] = np.zeros((n, 3))
+            h["radius"] = np.asarray(rad, float)
+            h["mass"] = 2650 * 4 / 3 * np.pi * np.asarray(rad, float) ** 3
+            h["material"] = np.zeros(n, np.int32)
+        lines.append(f"{t} {step} {n} {name}\n")
+    with open(os.path.join(case, "dem", "particles.series"), "w") as f:
+        f.writelines(lines)
+    with open(os.path.join(case, "dem", "summary.csv"), "w") as f:
+        f.write(summary_header + "\n")
+        for r in summary_rows:
+            f.write(",".join(str(v) for v in r) + "\n")
+
+
+@test
+def series_reader():
+    case = os.path.join(TMP, "series")
+    pos = np.array([[0, 0, 1.0], [1, 0, 0]])
+    write_case(case, "a 1;\n", [(0.0, pos, [0.1, 0.2]), (0.5, pos + 1, [0.1, 0.2])], [(0, 0, 2, 0, 0, 0, 0, 0)])
+    e = series.list_frames(case)
+    f = series.last_frame(case)
+    check("series index: times and files", [t for t, _ in e] == [0.0, 0.5])
+    check("frame arrays", f.time == 0.5 and np.allclose(f.position, pos + 1) and f.count == 2
+          and abs(f.total_mass - 2650 * 4 / 3 * np.pi * (0.1**3 + 0.2**3)) < 1e-9)
+    os.remove(os.path.join(case, "dem", "particles.series"))
+    check("glob fallback without the index", [t for t, _ in series.list_frames(case)] == [0.0, 0.5])
+    s = summary.read(case)
+    check("summary.csv columns", s["particles"][0] == 2 and "lostMass" in s)
+
+
+@test
+def plate_slid_fraction():
+    hinge_motion = {"tilt": {"type": "rotate", "start": 0.0, "end": 1.0, "axisPoint": [0, 0, 0], "axis": [0, -1, 0], "angularVelocity": 40}}
+    pose = geometry.WallPose(hinge_motion)
+    lo, hi = np.array([0, -0.03, -0.002]), np.array([0.08, 0.03, 0.0])
+    # 10 particles in the reference frame: 6 on the plate, 2 beyond its end, 1 too high, 1 below
+    ref = np.array([[0.01 * k, 0, 0.001] for k in range(1, 7)] + [[-0.001, 0, 0.001], [0.09, 0, 0.001], [0.02, 0, 0.05], [0.02, 0, -0.01]])
+    t = 0.5
+    R, x0 = pose.pose(t)
+    f = series.Frame.from_arrays(ref @ R.T + x0, 5e-4)
+    mask = plate.on_plate(f, pose, t, lo, hi, 0.02)
+    check("on-plate mask on a plate tilted 20 deg", mask.tolist() == [True] * 6 + [False] * 4)
+    angles = np.array([0, 10, 20, 30, 40.0])
+    frac = np.array([0, 0.1, 0.3, 0.7, 1.0])
+    check("angle at 50 % by interpolation", abs(plate.angle_at_fraction(angles, frac, 0.5) - 25.0) < 1e-12)
+    check("angle at fraction never reached", plate.angle_at_fraction(angles, frac * 0.4, 0.5) is None)
+    check("monotone test", plate.is_monotone_non_decreasing(frac) and not plate.is_monotone_non_decreasing(frac[::-1]))
+    stl = os.path.join(TMP, "plate.stl")
+    subprocess.run([sys.executable, os.path.join(ROOT, "tools", "writeBoxStl.py"), stl, "0", "-0.03", "-0.002", "0.08", "0.03", "0"], check=True)
+    blo, bhi = plate.read_stl_bounds(stl)
+    check("writeBoxStl + read_stl_bounds", np.allclose(blo, lo) and np.allclose(bhi, hi))
+    v = np.array([l.split()[1:4] for l in open(stl) if l.strip().startswith("vertex")], float).reshape(-1, 3, 3)
+    nrm = np.array([l.split()[2:5] for l in open(stl) if l.strip().startswith("facet")], float)
+    centre = v.reshape(-1, 3).mean(0)
+    check("box STL normals point outwards", len(v) == 12 and all(np.dot(nrm[i], v[i].mean(0) - centre) > 0 for i in range(12)))
+
+
+@test
+def repose_script_end_to_end():
+    case = os.path.join(TMP, "repose")
+    rng = np.random.default_rng(3)
+    p = cone_particles(28.0, 0.022, 6e-4, rng)
+    props = ("walls { floor { type plane; material steel; point (0 0 0); normal (0 0 1); }\n"
+             " tube { type cylinder; material steel; axisPoint (0 0 0); axis (0 0 1); radius 0.0215; range (0 0.5); side inside;\n"
+             "  motion { lift { type translate; start 0.1; end 0.3; velocity (0 0 0.2); } } removeAt 0.3; } }\n"
+             "contactModel { normal hertz; tangential history; rolling cdt; }\n")
+    write_case(case, props, [(0.5, p, np.full(len(p), 6e-4))], [(0.5, 100, len(p), 1e-9, 4, 0, 0, 0)])
+    r = subprocess.run([sys.executable, os.path.join(ROOT, "tools", "reposeAngle.py"), "-case", case], capture_output=True, text=True)
+    ok = r.returncode == 0
+    res = json.load(open(os.path.join(case, "postProcessing", "results.json"))) if ok else {}
+    angle = res.get("reposeAngle", {}).get("value", -1)
+    check("reposeAngle.py on a synthetic 28 deg cone: within 0.5 deg", ok and abs(angle - 28) < 0.5, f"(got {angle}) {r.stderr[-300:]}")
+    for png in ("reposeProfile.png", "sideView.png"):
+        pth = os.path.join(case, "postProcessing", png)
+        check(f"reposeAngle.py writes {png}", os.path.exists(pth) and open(pth, "rb").read(4) == b"\x89PNG")
+    csvp = os.path.join(case, "postProcessing", "results.csv")
+    check("results.csv lists the angle", os.path.exists(csvp) and "reposeAngle" in open(csvp).read())
+
+
+@test
+def plate_script_end_to_end():
+    # 10 particles on a plate tilted at 10 deg/s; at output k (angle 5k deg) k particles have fallen off
+    case = os.path.join(TMP, "plate")
+    os.makedirs(os.path.join(case, "constant", "triSurface"), exist_ok=True)
+    subprocess.run([sys.executable, os.path.join(ROOT, "tools", "writeBoxStl.py"), os.path.join(case, "constant/triSurface/plate.stl"),
+                    "0", "-0.03", "-0.002", "0.08", "0.03", "0"], check=True)
+    props = ("simulation { gravity (0 0 -9.81); }\ncontactModel { normal hertz; tangential history; rolling epsd2; }\n"
+             "walls { plate { type stl; material steel; file \"constant/triSurface/plate.stl\";\n"
+             " motion { tilt { type rotate; start 0; end 5; axisPoint (0 0 0); axis (0 -1 0); angularVelocity 10; } } } }\n")
+    pose = geometry.WallPose({"tilt": {"type": "rotate", "start": 0, "end": 5, "axisPoint": [0, 0, 0], "axis": [0, -1, 0], "angularVelocity": 10}})
+    ref = np.array([[0.005 + 0.007 * k, 0, 0.0006] for k in range(10)])
+    frames_data, rows = [], []
+    for k in range(11):
+        t = 0.5 * k
+        q = ref.copy()
+        q[:k, 2] = -0.05  # fallen: below the plate
+        R, x0 = pose.pose(t)
+        frames_data.append((t, q @ R.T + x0, np.full(10, 5e-4)))
+        rows.append((t, k, 10, 0, 0, 0, 0, 0))
+    write_case(case, props, frames_data, rows)
+    r = subprocess.run([sys.executable, os.path.join(ROOT, "tools", "inclinedPlate.py"), "-case", case], capture_output=True, text=True)
+    ok = r.returncode == 0
+    res = json.load(open(os.path.join(case, "postProcessing", "results.json"))) if ok else {}
+    a50 = res.get("angleAt50PercentSlid", {}).get("value", -1)
+    check("inclinedPlate.py: 50 % slid exactly at 25 deg", ok and abs(a50 - 25.0) < 1e-9, f"(got {a50}) {r.stderr[-300:]}")
+    check("inclinedPlate.py: monotone, final fraction 1", ok and res["slidFractionMonotone"]["value"] and abs(res["finalSlidFraction"]["value"] - 1) < 1e-12)
+    check("inclinedPlate.py writes slidFraction.png", os.path.exists(os.path.join(case, "postProcessing", "slidFraction.png")))
+
+
+@test
+def command_line_tools():
+    case = os.path.join(TMP, "cli")
+    pos = np.array([[0.001, 0, 0.001], [0.002, 0, 0.003], [0.05, 0, 0.001]])
+    write_case(case, "a 1;\n", [(0.0, pos, [5e-4] * 3), (1.0, pos + [0, 0, 0.1], [5e-4] * 3)], [(0, 0, 3, 0, 0, 0, 0, 0)])
+    m1 = 2650 * 4 / 3 * np.pi * 5e-4**3
+    r = subprocess.run([sys.executable, os.path.join(ROOT, "tools", "regionMasses.py"), "-case", case,
+                        "-box", "near", "0", "-1", "0", "0.01", "1", "0.01", "-reference", str(2 * m1)], capture_output=True, text=True)
+    rows = open(os.path.join(case, "postProcessing", "regionMasses.csv")).read().splitlines() if r.returncode == 0 else []
+    ok = len(rows) == 3 and abs(float(rows[1].split(",")[1]) - 2 * m1) < 1e-5 * m1 and rows[1].split(",")[2] == "1" \
+        and float(rows[2].split(",")[1]) == 0.0
+    check("regionMasses.py: mass and fill ratio in a box over time", ok, r.stderr[-300:] + str(rows))
+    r = subprocess.run([sys.executable, os.path.join(ROOT, "tools", "bedProfile.py"), "-case", case, "-time", "0",
+                        "-line", "0", "0", "0", "1", "0", "0", "-binWidth", "0.001"], capture_output=True, text=True)
+    rows = open(os.path.join(case, "postProcessing", "bedProfile.csv")).read().splitlines()[1:] if r.returncode == 0 else []
+    ok = len(rows) > 3 and abs(float(rows[0].split(",")[1]) - 0.0015) < 1e-12 and abs(float(rows[1].split(",")[1]) - 0.0035) < 1e-12
+    check("bedProfile.py: tops of the particles per 1 mm bin", ok, r.stderr[-300:] + str(rows[:3]))
+    r = subprocess.run([sys.executable, os.path.join(ROOT, "tools", "sideView.py"), "-case", case, "-name", "sv"], capture_output=True, text=True)
+    check("sideView.py writes a PNG", r.returncode == 0 and os.path.exists(os.path.join(case, "postProcessing", "sv.png")))
+
+
+@test
+def plots_and_results():
+    rng = np.random.default_rng(4)
+    f = series.Frame.from_arrays(rng.random((300, 3)) * 0.01, 3e-4, velocity=rng.random((300, 3)))
+    out = os.path.join(TMP, "pics")
+    os.makedirs(out, exist_ok=True)
+    for cb in ("height", "speed", "omega"):
+        pth = plots.side_view(os.path.join(out, f"side_{cb}.png"), f, color_by=cb)
+        check(f"side view coloured by {cb} is a PNG", open(pth, "rb").read(4) == b"\x89PNG")
+    jp, cp = results.write(os.path.join(TMP, "res"), {"a": {"value": 1.5, "unit": "deg"}, "b": [1, 2], "c": "x"})
+    back = results.read(os.path.join(TMP, "res"))
+    check("results.json round trip", back["a"]["value"] == 1.5 and back["b"]["value"] == [1, 2] and back["c"]["value"] == "x")
+    check("results.csv rows", open(cp).read().splitlines()[1:] == ["a,1.5,deg,", "b,1 2,,", "c,x,,"])
+
+
+import shutil  # noqa: E402
+
+shutil.rmtree(TMP, ignore_errors=True)
+print(f"{PASSED} passed, {FAILED} failed")
+sys.exit(1 if FAILED else 0)

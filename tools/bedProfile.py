@@ -1,0 +1,57 @@
+#!/usr/bin/env python3
+"""Surface profile of the particle bed at one output time, along a line or around an axis.
+
+    bedProfile.py -case DIR [-time T] -line OX OY OZ DX DY DZ [-band W] [-binWidth B] [-window A B] [-name N]
+    bedProfile.py -case DIR [-time T] -axis PX PY PZ AX AY AZ [-sectors N] [-binWidth B] [-window A B] [-name N]
+
+Heights are the highest particle top (centre height + radius) per bin (see
+docs/post-processing.md).  With -window (mm, along the line / from the axis) a line is
+fitted and its angle reported; -window auto takes the pile flank (80 %-20 % of the peak).
+Writes postProcessing/<N>.csv and <N>.png (N default 'bedProfile')."""
+import argparse
+import csv
+import os
+
+import numpy as np
+
+from _common import frame_at, out_dir
+from diefillpost import plots, profile
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("-case", default=".")
+    ap.add_argument("-time", type=float, default=None)
+    g = ap.add_mutually_exclusive_group(required=True)
+    g.add_argument("-line", type=float, nargs=6, metavar="V")
+    g.add_argument("-axis", type=float, nargs=6, metavar="V")
+    ap.add_argument("-up", type=float, nargs=3, default=(0, 0, 1))
+    ap.add_argument("-band", type=float, default=None, help="half-width of the band around the line [m]")
+    ap.add_argument("-sectors", type=int, default=8)
+    ap.add_argument("-binWidth", type=float, default=None, help="[m] (default 1.5 mean diameters)")
+    ap.add_argument("-window", nargs=2, default=None, help="fit window in mm, or 'auto auto'")
+    ap.add_argument("-name", default="bedProfile")
+    a = ap.parse_args()
+    f = frame_at(a.case, a.time)
+    bw = a.binWidth or 1.5 * float(np.mean(2 * f.radius))
+    if a.line:
+        x, h = profile.line_profile(f.position, f.radius, a.line[:3], a.line[3:], a.up, bw, band=a.band)
+    else:
+        x, h, _ = profile.radial_profile(f.position, f.radius, a.axis[:3], a.axis[3:], bw, sectors=a.sectors)
+    fit = None
+    if a.window:
+        win = profile.flank_window(x, h) if a.window[0] == "auto" else (float(a.window[0]) * 1e-3, float(a.window[1]) * 1e-3)
+        fit = profile.fit_line(x, h, win)
+        print(f"angle {fit['angle']:.2f} deg over [{win[0]*1e3:.1f}, {win[1]*1e3:.1f}] mm ({fit['points']} bins)")
+    d = out_dir(a.case)
+    with open(os.path.join(d, a.name + ".csv"), "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["position_m", "height_m"])
+        for xi, hi in zip(x, h):
+            w.writerow([f"{xi:.6g}", "" if not np.isfinite(hi) else f"{hi:.6g}"])
+    plots.profile_with_fit(os.path.join(d, a.name + ".png"), x, h, fit, title=f"t = {f.time:.3f} s")
+    print(f"wrote {os.path.join(d, a.name)}.csv/.png")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,13 @@
+"""diefillpost: post-processing of diefill/demRun particle output without ParaView.
+
+Modules (one concept each):
+    foamdict   read constant/demProperties (OpenFOAM dictionary subset) into Python
+    series     the HDF5 particle series written by demRun (dem/particles_*.h5)
+    summary    dem/summary.csv
+    geometry   rotations, wall poses from the motion blocks, named regions
+    profile    bed surface profiles and fitted slope angles
+    plate      mass on a tilting plate, slid fraction vs plate angle
+    plots      PNG pictures (matplotlib, Agg)
+    results    results.json + results.csv
+"""
+__all__ = ["foamdict", "series", "summary", "geometry", "profile", "plate", "plots", "results"]
