@@ -278,6 +278,9 @@ CaseSetup readCaseSetup(const Dictionary& root, const std::string& caseDir) {
                                                        : BridgeVolumeWeight::DiameterProductTimesDistance;
             s.forces.capillaryForceScale =
                 coarseGrainCapillaryFactor(c.coarseGrain.factor, c.coarseGrain.capillaryExponent);
+            // Particle-wall bridges (sphere-plane form), off by default: the paper
+            // models particle-particle bridges only.
+            s.forces.wallBridges = coh.getOrDefault<bool>("wallBridges", false);
         }
     }
 

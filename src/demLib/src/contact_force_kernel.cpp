@@ -61,6 +61,7 @@ public:
             total.touchingPairs += stats[t].touchingPairs;
             total.wallContacts += stats[t].wallContacts;
             total.bridges += stats[t].bridges;
+            total.wallBridges += stats[t].wallBridges;
             total.releasedLiquid += stats[t].releasedLiquid;
             wallCount += newWall[t].size();
         }
@@ -167,50 +168,78 @@ private:
                     const InteractionTable& interactions, double time, double dt, int begin, int end,
                     Vec3* force, Vec3* torque, std::vector<WallContactRecord>& out,
                     ContactStatistics& stats) const {
-        std::vector<WallContact> found;
-        const int wallCount = static_cast<int>(walls.size());
-        std::vector<BoundingBox> boxes(wallCount);
-        std::vector<char> active(wallCount);
-        for (int w = 0; w < wallCount; ++w) {
-            active[w] = walls[w].isActive(time);
-            if (active[w]) boxes[w] = walls[w].boundingBox(time);
-        }
+        constexpr bool capillary = Cohesion == CohesionModel::Capillary;
+        const bool bridges = capillary && settings_.wallBridges;
+        const double reach = bridges ? old.bridgeReach() : 0.0;
+        WallProximityQuery query(walls, time);
         for (int i = begin; i < end; ++i) {
             const std::size_t first = out.size();
             const Vec3 xi = p.position[i];
             const double ri = p.radius[i];
-            for (int w = 0; w < wallCount; ++w) {
-                if (!active[w] || !boxes[w].overlapsSphere(xi, ri)) continue;
-                found.clear();
-                walls[w].findContacts(xi, ri, time, found);
-                for (const WallContact& c : found) {
-                    if (c.overlap <= 0.0) continue;
-                    ++stats.wallContacts;
-                    WallContactRecord rec;
-                    rec.particle = i;
-                    rec.wall = w;
-                    rec.feature = c.feature;
-                    if (const WallContactRecord* prev = old.find(i, w, c.feature)) rec.history = prev->history;
-                    const double ci = ri - 0.5 * c.overlap;
-                    ContactKinematics kin;
-                    kin.normal = c.normal;
-                    kin.overlap = c.overlap;
-                    kin.radiusEff = ri;
-                    kin.massEff = p.mass[i];
-                    kin.relVelocity = p.velocity[i] - ci * p.omega[i].cross(c.normal) - c.wallVelocity;
-                    kin.relOmega = p.omega[i];
-                    kin.dt = dt;
-                    kin.isWall = true;
-                    if constexpr (Rolling == RollingModel::EPSD)
-                        kin.rollingInertiaEff = rollingInertiaWall(p.mass[i], ri);
-                    const ContactForces f =
-                        Law::evaluate(kin, interactions(p.material[i], walls[w].materialIndex), rec.history, 0.0);
-                    force[i] += f.force;
-                    torque[i] += -ci * c.normal.cross(f.tangentialForce) + f.rollingTorque;
-                    out.push_back(rec);
+            query.forEachNear(xi, ri, reach, [&](int w, const WallContact& c) {
+                const bool touching = c.overlap > 0.0;
+                if (!touching && !bridges) return;
+                WallContactRecord rec;
+                rec.particle = i;
+                rec.wall = w;
+                rec.feature = c.feature;
+                const WallContactRecord* prev = old.find(i, w, c.feature);
+                double cohesiveForce = 0.0;
+                if (bridges && prev && prev->bridgeVolume > 0.0) {
+                    const double gap = -c.overlap;
+                    if (gap > debondingDistance(prev->bridgeVolume, settings_.capillary.contactAngle)) {
+                        stats.releasedLiquid += prev->bridgeVolume;  // back to the free liquid
+                    } else {
+                        rec.bridgeVolume = prev->bridgeVolume;
+                        cohesiveForce = settings_.capillaryForceScale *
+                                        capillaryForceSphereWall(ri, gap, prev->bridgeVolume, settings_.capillary);
+                        ++stats.wallBridges;
+                    }
                 }
-            }
+                if (!touching) {
+                    // Within the bridge reach only: no contact history, the
+                    // bridge pulls along the wall normal through the centre.
+                    force[i] += cohesiveForce * c.normal;
+                    out.push_back(rec);
+                    return;
+                }
+                ++stats.wallContacts;
+                if (prev) rec.history = prev->history;
+                const double ci = ri - 0.5 * c.overlap;
+                ContactKinematics kin;
+                kin.normal = c.normal;
+                kin.overlap = c.overlap;
+                kin.radiusEff = ri;
+                kin.massEff = p.mass[i];
+                kin.relVelocity = p.velocity[i] - ci * p.omega[i].cross(c.normal) - c.wallVelocity;
+                kin.relOmega = p.omega[i];
+                kin.dt = dt;
+                kin.isWall = true;
+                if constexpr (Rolling == RollingModel::EPSD)
+                    kin.rollingInertiaEff = rollingInertiaWall(p.mass[i], ri);
+                const ContactForces f = Law::evaluate(kin, interactions(p.material[i], walls[w].materialIndex),
+                                                      rec.history, cohesiveForce);
+                force[i] += f.force;
+                torque[i] += -ci * c.normal.cross(f.tangentialForce) + f.rollingTorque;
+                out.push_back(rec);
+            });
             std::sort(out.begin() + first, out.end());
+            if (bridges) releaseLostWallBridges(old, i, out, first, stats);
+        }
+    }
+
+    // A wall bridge whose wall is no longer within the search reach (the
+    // particle jumped past it in one step, or the wall was removed) is not
+    // listed again: its liquid goes back to the pool.
+    static void releaseLostWallBridges(const ParticleWallContacts& old, int particle,
+                                       const std::vector<WallContactRecord>& out, std::size_t first,
+                                       ContactStatistics& stats) {
+        const auto [lo, hi] = old.rangeOf(particle);
+        for (std::size_t k = lo; k < hi; ++k) {
+            const WallContactRecord& r = old.records()[k];
+            if (!(r.bridgeVolume > 0.0)) continue;
+            const bool listed = std::binary_search(out.begin() + first, out.end(), r);
+            if (!listed) stats.releasedLiquid += r.bridgeVolume;
         }
     }
 };

@@ -14,6 +14,14 @@ const WallContactRecord* ParticleWallContacts::find(int particle, int wall, int 
     return &*it;
 }
 
+std::pair<std::size_t, std::size_t> ParticleWallContacts::rangeOf(int particle) const {
+    const auto byParticle = [](const WallContactRecord& r, int p) { return r.particle < p; };
+    const auto first = std::lower_bound(records_.begin(), records_.end(), particle, byParticle);
+    auto last = first;
+    while (last != records_.end() && last->particle == particle) ++last;
+    return {static_cast<std::size_t>(first - records_.begin()), static_cast<std::size_t>(last - records_.begin())};
+}
+
 void ParticleWallContacts::remap(const std::vector<int>& oldToNew) {
     std::vector<WallContactRecord> kept;
     kept.reserve(records_.size());
@@ -24,6 +32,14 @@ void ParticleWallContacts::remap(const std::vector<int>& oldToNew) {
     }
     std::sort(kept.begin(), kept.end());
     records_.swap(kept);
+}
+
+WallProximityQuery::WallProximityQuery(const std::vector<Wall>& walls, double time)
+    : walls_(walls), time_(time), active_(walls.size()), boxes_(walls.size()) {
+    for (std::size_t w = 0; w < walls.size(); ++w) {
+        active_[w] = walls[w].isActive(time);
+        if (active_[w]) boxes_[w] = walls[w].boundingBox(time);
+    }
 }
 
 }  // namespace dem

@@ -111,21 +111,41 @@ double Simulation::maxAllowedTimeStep() const {
 void Simulation::setWaterContent(double w) {
     const double volume = waterVolumeFromContent(w, particles_.totalMass(), 1000.0, settings_.source);
     liquid_.waterContent = w;
+    // Water added for new particles waits in the pool until the next update.
+    liquid_.poolVolume += volume - liquid_.totalVolume;
     liquid_.totalVolume = volume;
     liquidNetwork_ = std::make_unique<LiquidBridgeNetwork>(volume, settings_.bridges);
     largestBridge_ = 0.0;
     forcesValid_ = false;
 }
 
-double Simulation::liquidInBridges() const {
-    double sum = 0.0, carry = 0.0;  // Kahan: the conservation check is to 1e-12
-    for (const PairState& s : pairs_.state()) {
-        const double y = s.bridgeVolume - carry;
+namespace {
+
+// Kahan-compensated running sum: the conservation check is to 1e-12 of the total.
+struct CompensatedSum {
+    double sum = 0.0;
+    double carry = 0.0;
+    void add(double value) {
+        const double y = value - carry;
         const double t = sum + y;
         carry = (t - sum) - y;
         sum = t;
     }
-    return sum;
+};
+
+}  // namespace
+
+double Simulation::liquidInBridges() const {
+    CompensatedSum total;
+    for (const PairState& s : pairs_.state()) total.add(s.bridgeVolume);
+    for (const WallContactRecord& r : wallContacts_.records()) total.add(r.bridgeVolume);
+    return total.sum;
+}
+
+double Simulation::liquidInWallBridges() const {
+    CompensatedSum total;
+    for (const WallContactRecord& r : wallContacts_.records()) total.add(r.bridgeVolume);
+    return total.sum;
 }
 
 double Simulation::liquidCoordinationNumber() const {
@@ -158,6 +178,8 @@ void Simulation::removeLostParticles() {
         for (std::size_t i = 0; i + 1 < offsets.size(); ++i)
             for (int k = offsets[i]; k < offsets[i + 1]; ++k)
                 if (!keep[i] || !keep[neighbors[k]]) liquid_.poolVolume += pairs_.state()[k].bridgeVolume;
+        for (const WallContactRecord& r : wallContacts_.records())
+            if (!keep[r.particle]) liquid_.poolVolume += r.bridgeVolume;
     }
     const std::vector<int> oldToNew = particles_.compact(keep);
     pairs_.remap(oldToNew);
@@ -179,10 +201,39 @@ void Simulation::updatePairList() {
     }
     pairs_.setRanges(settings_.skinFraction * 2.0 * rMax, extra);
     pairs_.build(particles_);
-    if (liquidNetwork_) redistributeLiquid();
+    if (liquidNetwork_) redistributeLiquid(extra);
 }
 
-void Simulation::redistributeLiquid() {
+void Simulation::wallBridgeCandidates(double reach, std::vector<WallContactRecord>& records,
+                                      std::vector<double>& gaps) const {
+    records.clear();
+    gaps.clear();
+    std::vector<std::pair<WallContactRecord, double>> near;
+    WallProximityQuery query(walls_, time_);
+    for (std::size_t i = 0; i < particles_.size(); ++i) {
+        near.clear();
+        query.forEachNear(particles_.position[i], particles_.radius[i], reach, [&](int w, const WallContact& c) {
+            WallContactRecord r;
+            r.particle = static_cast<int>(i);
+            r.wall = w;
+            r.feature = c.feature;
+            if (const WallContactRecord* prev = wallContacts_.find(r.particle, w, c.feature)) {
+                r.history = prev->history;
+                // Read only as "was bonded" (ContactThenPersist); replaced by the update.
+                r.bridgeVolume = prev->bridgeVolume;
+            }
+            near.emplace_back(r, -c.overlap);
+        });
+        std::sort(near.begin(), near.end(),
+                  [](const auto& a, const auto& b) { return a.first < b.first; });
+        for (const auto& [record, gap] : near) {
+            records.push_back(record);
+            gaps.push_back(gap);
+        }
+    }
+}
+
+void Simulation::redistributeLiquid(double wallReach) {
     BridgeCandidates candidates;
     const auto& offsets = pairs_.offsets();
     const auto& neighbors = pairs_.neighbors();
@@ -194,14 +245,41 @@ void Simulation::redistributeLiquid() {
             candidates.add(particles_.radius[i], particles_.radius[j],
                            (particles_.position[i] - particles_.position[j]).norm(), state[k].bridgeVolume > 0.0);
         }
+    // Particle-wall bridges (option): the wall enters the distribution as a
+    // mirror particle, the candidate (R, R, 2R + gap) -- it takes the share of a
+    // same-size neighbour at the same gap, and the gap tested against δmax is
+    // the wall gap (docs/capillary-model.md, "Wall bridges").
+    std::vector<WallContactRecord> wallRecords;
+    std::vector<double> wallGaps;
+    if (settings_.forces.wallBridges) {
+        wallBridgeCandidates(wallReach, wallRecords, wallGaps);
+        for (std::size_t m = 0; m < wallRecords.size(); ++m) {
+            const double radius = particles_.radius[wallRecords[m].particle];
+            candidates.add(radius, radius, 2.0 * radius + wallGaps[m], wallRecords[m].bridgeVolume > 0.0);
+        }
+    }
     const BridgeDistribution& d = liquidNetwork_->update(candidates);
     largestBridge_ = 0.0;
+    liquid_.bridgeCount = 0;
+    liquid_.wallBridgeCount = 0;
     for (std::size_t k = 0; k < state.size(); ++k) {
         state[k].bridgeVolume = d.volume[k];
         largestBridge_ = std::max(largestBridge_, d.volume[k]);
+        if (d.volume[k] > 0.0) ++liquid_.bridgeCount;
+    }
+    if (settings_.forces.wallBridges) {
+        for (std::size_t m = 0; m < wallRecords.size(); ++m) {
+            const double volume = d.volume[state.size() + m];
+            wallRecords[m].bridgeVolume = volume;
+            largestBridge_ = std::max(largestBridge_, volume);
+            if (volume > 0.0) ++liquid_.wallBridgeCount;
+        }
+        wallContacts_.records().swap(wallRecords);
+        // Follow every wall bridge out to its own debonding distance.
+        wallContacts_.setBridgeReach(
+            std::max(wallReach, debondingDistance(largestBridge_, settings_.bridges.contactAngle)));
     }
     liquid_.poolVolume = d.freeLiquid;
-    liquid_.bridgeCount = d.bondCount;
 }
 
 void Simulation::computeForces() {
@@ -217,6 +295,7 @@ void Simulation::computeForces() {
     if (liquidNetwork_) {
         liquid_.poolVolume += last_.contacts.releasedLiquid;
         liquid_.bridgeCount = last_.contacts.bridges;
+        liquid_.wallBridgeCount = last_.contacts.wallBridges;
     }
 }
 

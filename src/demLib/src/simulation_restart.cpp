@@ -36,6 +36,8 @@ void Simulation::writeRestart(const std::string& path) const {
         f.setAttribute("bridgeCount", static_cast<std::int64_t>(liquid_.bridgeCount));
         f.setAttribute("hasLiquid", static_cast<std::int64_t>(liquidNetwork_ != nullptr));
         f.setAttribute("largestBridge", largestBridge_);
+        f.setAttribute("wallBridgeCount", static_cast<std::int64_t>(liquid_.wallBridgeCount));
+        f.setAttribute("wallBridgeReach", wallContacts_.bridgeReach());
         f.setAttribute("listSkin", pairs_.skin());
         f.setAttribute("listExtraRange", pairs_.extraRange());
         f.setAttribute("listBuildCount", static_cast<std::int64_t>(pairs_.buildCount()));
@@ -150,6 +152,14 @@ void Simulation::readRestart(const std::string& path) {
     liquid_.waterContent = f.doubleAttribute("waterContent");
     liquid_.bridgeCount = f.intAttribute("bridgeCount");
     largestBridge_ = f.doubleAttribute("largestBridge");
+    // Written by every version that has wall bridges; files from before them
+    // can only continue runs without the option.
+    liquid_.wallBridgeCount = 0;
+    wallContacts_.setBridgeReach(0.0);
+    if (settings_.forces.wallBridges) {
+        liquid_.wallBridgeCount = f.intAttribute("wallBridgeCount");
+        wallContacts_.setBridgeReach(f.doubleAttribute("wallBridgeReach"));
+    }
     liquidNetwork_.reset();
     if (f.intAttribute("hasLiquid"))
         liquidNetwork_ = std::make_unique<LiquidBridgeNetwork>(liquid_.totalVolume, settings_.bridges);
@@ -195,6 +205,11 @@ void Simulation::readRestart(const std::string& path) {
         r.history.shear = wShear[k];
         r.history.rollingTorque = wRolling[k];
         r.bridgeVolume = wBridge[k];
+        // A run continued without wall bridges: their liquid waits in the pool.
+        if (!settings_.forces.wallBridges) {
+            liquid_.poolVolume += r.bridgeVolume;
+            r.bridgeVolume = 0.0;
+        }
         records.push_back(r);
     }
     std::sort(records.begin(), records.end());

@@ -25,12 +25,16 @@ struct ForceFieldSettings {
     // Multiplies every capillary force: the coarse-grain correction l^κ of the
     // paper's eq 9 (1 for original-size particles).
     double capillaryForceScale = 1.0;
+    // Particle-wall liquid bridges (capillaryForceSphereWall); walls are then
+    // searched out to ParticleWallContacts::bridgeReach() beyond contact.
+    bool wallBridges = false;
 };
 
 struct ContactStatistics {
     std::size_t touchingPairs = 0;   // particle-particle pairs with overlap > 0
     std::size_t wallContacts = 0;    // particle-wall contacts with overlap > 0
-    std::size_t bridges = 0;         // capillary bridges holding liquid
+    std::size_t bridges = 0;         // particle-particle capillary bridges holding liquid
+    std::size_t wallBridges = 0;     // particle-wall capillary bridges holding liquid
     double releasedLiquid = 0.0;     // volume of bridges that broke this step
 };
 
@@ -39,6 +43,8 @@ public:
     virtual ~ContactForceKernel() = default;
     // Adds contact forces and torques to particles.force / particles.torque
     // (which hold body and external forces on entry) and updates the history.
+    // Bridges that break (gap beyond eq 5, or a wall bridge whose wall left the
+    // search reach) are emptied; their volume is returned in releasedLiquid.
     virtual ContactStatistics compute(ParticleStore& particles, ParticleParticleNeighborList& pairs,
                                       ParticleWallContacts& wallContacts, const std::vector<Wall>& walls,
                                       const InteractionTable& interactions, double time, double dt) = 0;

@@ -2,10 +2,18 @@
 // Particle-wall contacts with their history.  The list is rebuilt every step in
 // particle order (then wall, then feature), so the history of a contact is found
 // again by binary search and the list is identical for any thread count.
+//
+// With capillary wall bridges the list also holds walls that do not touch the
+// particle but lie within the bridge reach of its surface (gap <= reach): they
+// may hold a liquid bridge (bridgeVolume) and are candidates of the liquid
+// distribution.  Without wall bridges the reach is 0 and only touching walls
+// are listed.
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "demLib/contact_law.hpp"
+#include "demLib/wall.hpp"
 
 namespace dem {
 
@@ -14,7 +22,7 @@ struct WallContactRecord {
     int wall = 0;
     int feature = 0;
     ContactHistory history;
-    double bridgeVolume = 0.0;
+    double bridgeVolume = 0.0;  // liquid held by a particle-wall bridge (0: none)
 
     bool sameKey(const WallContactRecord& o) const {
         return particle == o.particle && wall == o.wall && feature == o.feature;
@@ -30,15 +38,55 @@ class ParticleWallContacts {
 public:
     // History of (particle, wall, feature) from the previous step, or null.
     const WallContactRecord* find(int particle, int wall, int feature) const;
+    // Index range [first, second) of the records of one particle.
+    std::pair<std::size_t, std::size_t> rangeOf(int particle) const;
 
     std::vector<WallContactRecord>& records() { return records_; }
     const std::vector<WallContactRecord>& records() const { return records_; }
+
+    // Distance beyond contact (sphere surface to wall) within which walls are
+    // listed: the capillary debonding reach with wall bridges, else 0.
+    void setBridgeReach(double reach) { bridgeReach_ = reach; }
+    double bridgeReach() const { return bridgeReach_; }
 
     // Particles were reordered or removed (see ParticleStore::compact/permute).
     void remap(const std::vector<int>& oldToNew);
 
 private:
     std::vector<WallContactRecord> records_;
+    double bridgeReach_ = 0.0;
+};
+
+// The walls near one sphere at one time.  Caches which walls are active and
+// their bounding boxes; forEachNear() reports every wall feature whose surface
+// lies within `reach` of the sphere surface, with the TRUE overlap (radius -
+// distance; negative = gap).  reach = 0 is the plain contact search.
+class WallProximityQuery {
+public:
+    WallProximityQuery(const std::vector<Wall>& walls, double time);
+
+    // visit(int wallIndex, const WallContact& contact) for each feature, walls in
+    // index order, features in the order the wall reports them.
+    template <class Visit>
+    void forEachNear(const Vec3& centre, double radius, double reach, Visit&& visit) {
+        const double searchRadius = radius + reach;
+        for (int w = 0; w < static_cast<int>(walls_.size()); ++w) {
+            if (!active_[w] || !boxes_[w].overlapsSphere(centre, searchRadius)) continue;
+            found_.clear();
+            walls_[w].findContacts(centre, searchRadius, time_, found_);
+            for (WallContact& c : found_) {
+                if (reach != 0.0) c.overlap -= reach;
+                visit(w, c);
+            }
+        }
+    }
+
+private:
+    const std::vector<Wall>& walls_;
+    double time_;
+    std::vector<char> active_;
+    std::vector<BoundingBox> boxes_;
+    std::vector<WallContact> found_;
 };
 
 }  // namespace dem

@@ -50,12 +50,14 @@ struct StepStatistics {
     std::size_t lostThisStep = 0;
 };
 
-// Capillary liquid bookkeeping; volumes in m^3.  total = bridges + pool always.
+// Capillary liquid bookkeeping; volumes in m^3.
+// total = particle bridges + wall bridges + pool, always (to rounding).
 struct LiquidState {
     double totalVolume = 0.0;   // water added, conserved
     double poolVolume = 0.0;    // not held by any bridge (redistributed at list updates)
     double waterContent = 0.0;  // mass of water / mass of dry solid
-    std::size_t bridgeCount = 0;
+    std::size_t bridgeCount = 0;      // particle-particle bridges
+    std::size_t wallBridgeCount = 0;  // particle-wall bridges (option wallBridges)
 };
 
 class Simulation {
@@ -92,9 +94,13 @@ public:
     double lostMass() const { return lostMass_; }
     std::int64_t nextId() const { return nextId_; }
 
-    // Liquid volume held by bridges plus the free pool (conserved quantity).
+    // Liquid volume held by all bridges, particle-particle and particle-wall
+    // (plus liquid().poolVolume it is the conserved total).
     double liquidInBridges() const;
-    // Mean number of capillary bridges per particle (liquid coordination number).
+    // The part of liquidInBridges() held by particle-wall bridges.
+    double liquidInWallBridges() const;
+    // Mean number of particle-particle capillary bridges per particle
+    // (liquid coordination number z = 2 bridges / N; wall bridges not counted).
     double liquidCoordinationNumber() const;
     // Mean number of touching contacts per particle.
     double coordinationNumber() const;
@@ -109,7 +115,11 @@ public:
 private:
     void removeLostParticles();
     void updatePairList();
-    void redistributeLiquid();
+    void redistributeLiquid(double wallReach);
+    // Walls within `reach` of each particle's surface at the current positions:
+    // records (sorted, history of the current list carried) and their gaps.
+    void wallBridgeCandidates(double reach, std::vector<WallContactRecord>& records,
+                              std::vector<double>& gaps) const;
     void computeForces();
 
     SimulationSettings settings_;
