@@ -29,6 +29,7 @@ public:
 
     ContactStatistics compute(ParticleStore& p, ParticleParticleNeighborList& pairs,
                               ParticleWallContacts& wallContacts, const std::vector<Wall>& walls,
+                              const ParticleWallCandidates& wallCandidates,
                               const InteractionTable& interactions, double time, double dt) override {
         const int n = static_cast<int>(p.size());
         const int threads = threadsFor(n, heavyLoopParticlesPerThread);
@@ -51,8 +52,8 @@ public:
             const int begin = static_cast<int>(static_cast<long>(n) * t / threads);
             const int end = static_cast<int>(static_cast<long>(n) * (t + 1) / threads);
             pairForces(p, pairs, interactions, dt, begin, end, force, torque, stats[t]);
-            wallForces(p, wallContacts, walls, interactions, time, dt, begin, end, force, torque,
-                       newWall[t], stats[t]);
+            wallForces(p, wallContacts, walls, wallCandidates, interactions, time, dt, begin, end, force,
+                       torque, newWall[t], stats[t]);
         }
 
         ContactStatistics total;
@@ -165,7 +166,7 @@ private:
     }
 
     void wallForces(ParticleStore& p, const ParticleWallContacts& old, const std::vector<Wall>& walls,
-                    const InteractionTable& interactions, double time, double dt, int begin, int end,
+                    const ParticleWallCandidates& candidates, const InteractionTable& interactions, double time, double dt, int begin, int end,
                     Vec3* force, Vec3* torque, std::vector<WallContactRecord>& out,
                     ContactStatistics& stats) const {
         constexpr bool capillary = Cohesion == CohesionModel::Capillary;
@@ -176,7 +177,10 @@ private:
             const std::size_t first = out.size();
             const Vec3 xi = p.position[i];
             const double ri = p.radius[i];
-            query.forEachNear(xi, ri, reach, [&](int w, const WallContact& c) {
+            // Only the static walls listed near i at the last list build, and the moving walls.
+            const int* listed = candidates.walls().data();
+            query.forEachNearIn(listed + candidates.offsets()[i], listed + candidates.offsets()[i + 1],
+                                candidates.movingWalls(), xi, ri, reach, [&](int w, const WallContact& c) {
                 const bool touching = c.overlap > 0.0;
                 if (!touching && !bridges) return;
                 WallContactRecord rec;

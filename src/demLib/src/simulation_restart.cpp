@@ -213,6 +213,7 @@ void Simulation::readRestart(const std::string& path) {
         records.push_back(r);
     }
     std::sort(records.begin(), records.end());
+    rebuildWallCandidates();
 }
 
 }  // namespace dem

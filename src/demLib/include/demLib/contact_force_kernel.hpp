@@ -11,6 +11,7 @@
 #include "demLib/interaction_properties.hpp"
 #include "demLib/particle_particle_neighbor_list.hpp"
 #include "demLib/particle_store.hpp"
+#include "demLib/particle_wall_broad_search.hpp"
 #include "demLib/particle_wall_contacts.hpp"
 #include "demLib/wall.hpp"
 
@@ -47,6 +48,7 @@ public:
     // search reach) are emptied; their volume is returned in releasedLiquid.
     virtual ContactStatistics compute(ParticleStore& particles, ParticleParticleNeighborList& pairs,
                                       ParticleWallContacts& wallContacts, const std::vector<Wall>& walls,
+                                      const ParticleWallCandidates& wallCandidates,
                                       const InteractionTable& interactions, double time, double dt) = 0;
     const ForceFieldSettings& settings() const { return settings_; }
 

@@ -69,19 +69,35 @@ public:
     // index order, features in the order the wall reports them.
     template <class Visit>
     void forEachNear(const Vec3& centre, double radius, double reach, Visit&& visit) {
-        const double searchRadius = radius + reach;
-        for (int w = 0; w < static_cast<int>(walls_.size()); ++w) {
-            if (!active_[w] || !boxes_[w].overlapsSphere(centre, searchRadius)) continue;
-            found_.clear();
-            walls_[w].findContacts(centre, searchRadius, time_, found_);
-            for (WallContact& c : found_) {
-                if (reach != 0.0) c.overlap -= reach;
-                visit(w, c);
-            }
+        for (int w = 0; w < static_cast<int>(walls_.size()); ++w) visitWall(w, centre, radius, reach, visit);
+    }
+
+    // The same over the walls listed in the two ascending lists only (a
+    // particle's static candidates and the moving walls), in index order.
+    template <class Visit>
+    void forEachNearIn(const int* first, const int* last, const std::vector<int>& moving, const Vec3& centre,
+                       double radius, double reach, Visit&& visit) {
+        auto m = moving.begin();
+        while (first != last || m != moving.end()) {
+            const bool takeStatic = m == moving.end() || (first != last && *first < *m);
+            const int w = takeStatic ? *first++ : *m++;
+            visitWall(w, centre, radius, reach, visit);
         }
     }
 
 private:
+    template <class Visit>
+    void visitWall(int w, const Vec3& centre, double radius, double reach, Visit& visit) {
+        const double searchRadius = radius + reach;
+        if (!active_[w] || !boxes_[w].overlapsSphere(centre, searchRadius)) return;
+        found_.clear();
+        walls_[w].findContacts(centre, searchRadius, time_, found_);
+        for (WallContact& c : found_) {
+            if (reach != 0.0) c.overlap -= reach;
+            visit(w, c);
+        }
+    }
+
     const std::vector<Wall>& walls_;
     double time_;
     std::vector<char> active_;

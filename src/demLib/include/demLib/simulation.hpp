@@ -39,6 +39,9 @@ struct SimulationSettings {
     // smallest particle (LIGGGHTS warns above 0.2) unless explicitly allowed.
     double maxRayleighFraction = 0.2;
     bool allowLargeTimeStep = false;
+    // Systems of at least this many particles are sorted in space now and then
+    // (see Simulation::updatePairList); smaller ones keep their order.
+    std::size_t spatialSortMinParticles = 4096;
     // Particles whose centre leaves this box are removed and counted as lost.
     std::optional<AxisAlignedBox> domain;
     // Name of the input the settings came from, for error messages.
@@ -62,6 +65,9 @@ struct LiquidState {
 
 class Simulation {
 public:
+    // Particles are sorted in space at every spatialSortInterval-th list build.
+    static constexpr long spatialSortInterval = 16;
+
     Simulation(SimulationSettings settings, std::vector<Material> materials, InteractionTable interactions,
                std::vector<Wall> walls);
 
@@ -115,6 +121,7 @@ public:
 private:
     void removeLostParticles();
     void updatePairList();
+    void rebuildWallCandidates();
     void redistributeLiquid(double wallReach);
     // Walls within `reach` of each particle's surface at the current positions:
     // records (sorted, history of the current list carried) and their gaps.
@@ -129,6 +136,7 @@ private:
     ParticleStore particles_;
     ParticleParticleNeighborList pairs_;
     ParticleWallContacts wallContacts_;
+    ParticleWallCandidates wallCandidates_;
     std::unique_ptr<ContactForceKernel> kernel_;
     double time_ = 0.0;
     long step_ = 0;

@@ -1,0 +1,34 @@
+#pragma once
+// Particle-wall broad search: which walls each particle may touch before the
+// next neighbour-list rebuild.  A static wall is listed for a particle when the
+// particle is within its radius + skin of it at build time (it cannot reach a
+// wall farther away before some particle has moved skin/2 and the lists are
+// rebuilt).  Moving walls are not listed: they are checked for every particle
+// every step (their bounding box first).
+#include <vector>
+
+#include "demLib/particle_store.hpp"
+#include "demLib/wall.hpp"
+
+namespace dem {
+
+class ParticleWallCandidates {
+public:
+    // reach: the distance beyond contact a wall must be considered (skin plus
+    // any cohesion range).
+    void build(const ParticleStore& particles, const std::vector<Wall>& walls, double time, double reach);
+
+    // Static walls near particle i: entries [offsets()[i], offsets()[i+1]) of walls().
+    const std::vector<int>& offsets() const { return offsets_; }
+    const std::vector<int>& walls() const { return walls_; }
+    // Walls with a prescribed motion: checked for every particle.
+    const std::vector<int>& movingWalls() const { return moving_; }
+    bool empty() const { return offsets_.size() <= 1; }
+
+private:
+    std::vector<int> offsets_{0};
+    std::vector<int> walls_;
+    std::vector<int> moving_;
+};
+
+}  // namespace dem

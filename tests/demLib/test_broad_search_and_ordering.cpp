@@ -1,0 +1,73 @@
+// Spatial ordering of particles and the particle-wall candidate list.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+#include <set>
+
+#include "demLib/particle_reordering.hpp"
+#include "demLib/particle_wall_broad_search.hpp"
+
+using dem::Vec3;
+
+TEST(SpatialOrder, IsAPermutationGroupingEachCellContiguously) {
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    std::vector<Vec3> x(5000);
+    for (Vec3& p : x) p = Vec3(u(rng), u(rng), 0.5 * u(rng));
+    const double cell = 0.1;
+    const std::vector<int> order = dem::spatialOrder(x, cell);
+    ASSERT_EQ(order.size(), x.size());
+    std::vector<int> sorted = order;
+    std::sort(sorted.begin(), sorted.end());
+    for (int k = 0; k < static_cast<int>(sorted.size()); ++k) ASSERT_EQ(sorted[k], k);
+    // Cell keys never decrease along the new order, and each cell is one run.
+    // Cells are counted from the particles' lower corner, as the grid is.
+    Vec3 lo = x[0];
+    for (const Vec3& p : x) lo = lo.cwiseMin(p);
+    auto key = [&](int i) {
+        const Vec3 r = (x[i] - lo) / cell;
+        return (static_cast<long>(r.z()) * 100 + static_cast<long>(r.y())) * 100 + static_cast<long>(r.x());
+    };
+    std::set<long> finished;
+    for (std::size_t k = 1; k < order.size(); ++k) {
+        ASSERT_LE(key(order[k - 1]), key(order[k]));
+        if (key(order[k - 1]) != key(order[k])) {
+            ASSERT_TRUE(finished.insert(key(order[k - 1])).second);
+        }
+    }
+    // Stable within a cell: old indices ascend.
+    for (std::size_t k = 1; k < order.size(); ++k)
+        if (key(order[k - 1]) == key(order[k])) EXPECT_LT(order[k - 1], order[k]);
+    const std::vector<int> inverse = dem::inversePermutation(order);
+    for (std::size_t k = 0; k < order.size(); ++k) EXPECT_EQ(inverse[order[k]], static_cast<int>(k));
+}
+
+TEST(SpatialOrder, ScatteredParticlesDoNotBlowUpTheGrid) {
+    std::vector<Vec3> x = {Vec3(0, 0, 0), Vec3(1e3, 1e3, 1e3), Vec3(1e-3, 0, 0)};
+    const std::vector<int> order = dem::spatialOrder(x, 1e-3);  // 1e18 cells without the cap
+    EXPECT_EQ(order.size(), 3u);
+}
+
+TEST(ParticleWallCandidates, ListsStaticWallsWithinReachAndAllMovingWalls) {
+    dem::ParticleStore p;
+    p.add(0, Vec3(0, 0, 0.0012), Vec3::Zero(), 0.001, 2500, 0);  // 0.2 mm above the floor
+    p.add(1, Vec3(0, 0, 0.0050), Vec3::Zero(), 0.001, 2500, 0);  // 4 mm above
+    p.add(2, Vec3(0.0095, 0, 0.0011), Vec3::Zero(), 0.001, 2500, 0);  // near the floor and the side wall
+    std::vector<dem::Wall> walls;
+    walls.push_back({"floor", dem::PlaneWall(Vec3::Zero(), Vec3::UnitZ()), dem::WallMotion(), 0});
+    walls.push_back({"side", dem::PlaneWall(Vec3(0.01, 0, 0), -Vec3::UnitX()), dem::WallMotion(), 0});
+    dem::WallMotion lift;
+    lift.addTranslation(0.0, 1.0, Vec3(0, 0, 0.01));
+    walls.push_back({"lid", dem::PlaneWall(Vec3(0, 0, 0.02), -Vec3::UnitZ()), lift, 0});
+    dem::ParticleWallCandidates c;
+    c.build(p, walls, 0.0, 0.0005);
+    ASSERT_EQ(c.offsets().size(), 4u);
+    auto listed = [&](int i) {
+        return std::vector<int>(c.walls().begin() + c.offsets()[i], c.walls().begin() + c.offsets()[i + 1]);
+    };
+    EXPECT_EQ(listed(0), std::vector<int>({0}));      // floor within 1 mm + 0.5 mm
+    EXPECT_TRUE(listed(1).empty());                   // 4 mm from the floor, 10 mm from the side
+    EXPECT_EQ(listed(2), std::vector<int>({0, 1}));   // floor and side wall
+    EXPECT_EQ(c.movingWalls(), std::vector<int>({2}));  // the lid moves: checked every step
+}
