@@ -22,6 +22,9 @@ Description
         constant/demProperties       | the DEM (docs/case-reference.md)
         0/U, 0/p                     | interstitial velocity, p/rho
         0/alpha.air                  | optional: void-fraction BCs
+        <time>/uniform/particleForces| written: fluid forces on the particles,
+                                     | read back on a restart with the DEM
+                                     | restart file of the same step
 
 \*---------------------------------------------------------------------------*/
 
@@ -59,9 +62,19 @@ int main(int argc, char *argv[])
 
     turbulence->validate();
 
-    // Forces for the first DEM interval, from the initial air state
-    coupling.updateExchange(Ksp, KUp);
-    coupling.updateParticleForces(Ksp, KUp);
+    // Forces for the first DEM interval: from the initial air state, or as
+    // written at the restart time (then the continued run repeats the
+    // uninterrupted one)
+    if (coupling.restartForces())
+    {
+        Info<< "Coupling: fluid forces on the particles from "
+            << runTime.timeName()/"uniform/particleForces" << endl;
+    }
+    else
+    {
+        coupling.updateExchange(Ksp, KUp);
+        coupling.updateParticleForces(Ksp, KUp);
+    }
 
     // * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * //
 
@@ -110,6 +123,10 @@ int main(int argc, char *argv[])
         // --- The air's new state to the particles for the next DEM interval
         coupling.updateParticleForces(Ksp, KUp);
 
+        if (runTime.writeTime())
+        {
+            coupling.write();
+        }
         runTime.write();
 
         runTime.printExecutionTime(Info);

@@ -2,14 +2,19 @@
 #include "fvm.H"
 #include "fvc.H"
 #include "mathematicalConstants.H"
+#include "sigFpe.H"
+#include "vectorIOField.H"
 
 #include "demLib/case_runner.hpp"
 #include "demLib/case_setup.hpp"
 #include "demLib/error.hpp"
 #include "demLib/version.hpp"
 
+#include <cmath>
 #include <cstring>
+#include <iomanip>
 #include <iostream>
+#include <sstream>
 
 // Defined in demLib (src/demLib/src/version.cpp): the version of the library
 // actually loaded, as opposed to dem::versionString of the headers.
@@ -133,7 +138,8 @@ Foam::diefill::demCoupling::demCoupling
     smoothingLength_(dict_.getOrDefault<scalar>("smoothingLength", 0)),
     g_("g", dimAcceleration, Zero),
     K_(),
-    nLost_(0)
+    nLost_(0),
+    restartForces_(false)
 {
     checkLibraryVersion();
 
@@ -214,9 +220,28 @@ Foam::diefill::demCoupling::demCoupling
 
     dem::RunOptions options;
     options.progressInterval = 0;
-    if (mesh_.time().startTime().value() > 0)
+    const scalar startTime = mesh_.time().startTime().value();
+    if (startTime > 0)
     {
-        options.restartFrom = "latest";
+        // The DEM restart file of the step at the air's start time (demLib
+        // names them restart_<step>.h5), not merely the newest one: a run
+        // continued from an earlier fluid time must find its own.
+        const label step = label(std::round(startTime/setup.settings.timeStep));
+        std::ostringstream name;
+        name<< "restart_" << std::setw(9) << std::setfill('0') << step << ".h5";
+        const fileName restartFile =
+            caseDir/fileName(setup.output.directory)/"restart"/name.str();
+        if (!isFile(restartFile))
+        {
+            FatalErrorInFunction
+                << "The air starts at " << startTime << " s (DEM step "
+                << step << ") but there is no DEM restart file "
+                << restartFile << nl
+                << "    Write restart files at the fluid write times"
+                << " (output/restartInterval in constant/demProperties)."
+                << exit(FatalError);
+        }
+        options.restartFrom = restartFile;
     }
 
     nullLog_.reset(new std::ostream(nullptr));
@@ -224,6 +249,10 @@ Foam::diefill::demCoupling::demCoupling
 
     try
     {
+        // demLib relies on IEEE arithmetic without traps (unbounded boxes of
+        // plane walls are infinite); its OpenMP threads inherit the trapping
+        // state of this thread when the pool is created, here or below.
+        sigFpe::ignore noTrapping;
         runner_.reset(new dem::CaseRunner(std::move(setup), options, log));
     }
     catch (const std::exception& e)
@@ -240,6 +269,41 @@ Foam::diefill::demCoupling::demCoupling
             << "The DEM is at time " << demTime << " s but the air starts at "
             << mesh_.time().value() << " s: restart both from the same time."
             << exit(FatalError);
+    }
+
+    // The fluid forces the particles had at the restart time (written with
+    // the air fields, see write()): with them the continued run repeats the
+    // uninterrupted one.  The DEM restart file holds the forces of the
+    // interval before, so they are not taken from there.
+    if (startTime > 0)
+    {
+        IOobject forcesHeader
+        (
+            "particleForces",
+            mesh_.time().timeName(),
+            "uniform",
+            mesh_,
+            IOobject::MUST_READ,
+            IOobject::NO_WRITE
+        );
+        if (forcesHeader.typeHeaderOk<vectorIOField>(true))
+        {
+            const vectorIOField forces(forcesHeader);
+            auto& particles = runner_->simulation().particles();
+            if (forces.size() != label(particles.size()))
+            {
+                FatalErrorInFunction
+                    << forcesHeader.objectPath() << " holds " << forces.size()
+                    << " forces but the DEM restart file "
+                    << particles.size() << " particles." << exit(FatalError);
+            }
+            forAll(forces, i)
+            {
+                particles.externalForce[i] =
+                    dem::Vec3(forces[i].x(), forces[i].y(), forces[i].z());
+            }
+            restartForces_ = true;
+        }
     }
 
     const auto& gDem = runner_->setup().settings.gravity;
@@ -279,6 +343,7 @@ void Foam::diefill::demCoupling::evolve()
     demStepsPerFluidStep();
     try
     {
+        sigFpe::ignore noTrapping;
         runner_->advanceTo(mesh_.time().value());
     }
     catch (const std::exception& e)
@@ -493,7 +558,33 @@ void Foam::diefill::demCoupling::updateParticleForces
 }
 
 
+void Foam::diefill::demCoupling::write() const
+{
+    const auto& particles = runner_->simulation().particles();
+    vectorIOField forces
+    (
+        IOobject
+        (
+            "particleForces",
+            mesh_.time().timeName(),
+            "uniform",
+            mesh_,
+            IOobject::NO_READ,
+            IOobject::NO_WRITE
+        ),
+        label(particles.size())
+    );
+    forAll(forces, i)
+    {
+        const auto& f = particles.externalForce[i];
+        forces[i] = vector(f.x(), f.y(), f.z());
+    }
+    forces.write();
+}
+
+
 void Foam::diefill::demCoupling::finish()
 {
+    sigFpe::ignore noTrapping;
     runner_->finish();
 }

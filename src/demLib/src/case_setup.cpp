@@ -230,6 +230,8 @@ CaseSetup readCaseSetup(const Dictionary& root, const std::string& caseDir) {
     if (sim.has("skinFraction")) s.skinFraction = sim.getInRange("skinFraction", 1e-3, 2.0);
     if (sim.has("maxRayleighFraction")) s.maxRayleighFraction = sim.getInRange("maxRayleighFraction", 1e-3, 1.0);
     s.allowLargeTimeStep = sim.getOrDefault<bool>("allowLargeTimeStep", false);
+    if (sim.has("maxHertzFraction")) s.maxHertzFraction = sim.getInRange("maxHertzFraction", 1e-3, 1.0);
+    if (sim.has("impactVelocity")) s.impactVelocity = sim.getPositive("impactVelocity");
     if (sim.has("domain")) {
         const Dictionary& box = sim.subDict("domain");
         AxisAlignedBox b{box.get<Vec3>("min"), box.get<Vec3>("max")};

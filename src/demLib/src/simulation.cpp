@@ -23,13 +23,16 @@ std::string formatVec(const Vec3& v) {
 
 // Throws InputError when settings.timeStep exceeds `allowed` (unless the
 // settings allow a large time step), naming both values.
-void requireTimeStepBelow(const SimulationSettings& settings, double allowed, const std::string& context) {
+void requireTimeStepBelow(const SimulationSettings& settings, const Simulation::TimeStepLimits& limits,
+                          const std::string& context) {
+    const double allowed = std::min(limits.rayleigh, limits.hertz);
     if (settings.timeStep > allowed && !settings.allowLargeTimeStep) {
         std::ostringstream s;
-        s << settings.source << ": keyword 'timeStep' = " << settings.timeStep << " s is larger than "
-          << settings.maxRayleighFraction << " x the Rayleigh time of the smallest particle (" << allowed
-          << " s allowed) after " << context
-          << "; expected timeStep <= " << allowed
+        s << settings.source << ": keyword 'timeStep' = " << settings.timeStep << " s is too large for the contact "
+          << "stiffness after " << context << ": " << settings.maxRayleighFraction
+          << " x the Rayleigh time of the smallest particle allows " << limits.rayleigh << " s, "
+          << settings.maxHertzFraction << " x its Hertz collision time at " << settings.impactVelocity
+          << " m/s (keyword 'impactVelocity') allows " << limits.hertz << " s; expected timeStep <= " << allowed
           << " (or set 'allowLargeTimeStep true' to override, at your own risk)";
         throw InputError(s.str());
     }
@@ -89,10 +92,7 @@ void Simulation::insert(const std::vector<InsertedParticle>& inserted, int mater
     }
     // The time step is checked before anything is added, so that a rejected
     // insertion leaves the simulation as it was.
-    double allowed = maxAllowedTimeStep();
-    for (const InsertedParticle& q : inserted)
-        allowed = std::min(allowed, settings_.maxRayleighFraction * criticalTimeStep(materials_[materialIndex], q.radius));
-    requireTimeStepBelow(settings_, allowed, context);
+    requireTimeStepBelow(settings_, timeStepLimits(inserted, materialIndex), context);
     const double density = materials_[materialIndex].density;
     particles_.reserve(particles_.size() + inserted.size());
     for (const InsertedParticle& q : inserted)
@@ -100,13 +100,26 @@ void Simulation::insert(const std::vector<InsertedParticle>& inserted, int mater
     forcesValid_ = false;
 }
 
+Simulation::TimeStepLimits Simulation::timeStepLimits(const std::vector<InsertedParticle>& adding,
+                                                      int materialIndex) const {
+    TimeStepLimits limits{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+    auto consider = [&](double radius, const Material& m) {
+        limits.rayleigh = std::min(limits.rayleigh, settings_.maxRayleighFraction * criticalTimeStep(m, radius));
+        // Two equal spheres head-on: LIGGGHTS uses the particle mass, R/2 and
+        // the pair's Y*, at twice the characteristic speed.
+        const double mass = m.density * 4.0 / 3.0 * 3.14159265358979323846 * radius * radius * radius;
+        const double hertz =
+            hertzCollisionTime(mass, 0.5 * radius, effectiveYoungsModulus(m, m), 2.0 * settings_.impactVelocity);
+        limits.hertz = std::min(limits.hertz, settings_.maxHertzFraction * hertz);
+    };
+    for (std::size_t i = 0; i < particles_.size(); ++i) consider(particles_.radius[i], materials_[particles_.material[i]]);
+    for (const InsertedParticle& q : adding) consider(q.radius, materials_[materialIndex]);
+    return limits;
+}
+
 double Simulation::maxAllowedTimeStep() const {
-    double smallest = std::numeric_limits<double>::infinity();
-    for (std::size_t i = 0; i < particles_.size(); ++i) {
-        const Material& m = materials_[particles_.material[i]];
-        smallest = std::min(smallest, criticalTimeStep(m, particles_.radius[i]));
-    }
-    return settings_.maxRayleighFraction * smallest;
+    const TimeStepLimits limits = timeStepLimits();
+    return std::min(limits.rayleigh, limits.hertz);
 }
 
 void Simulation::setWaterContent(double w) {

@@ -39,6 +39,11 @@ struct SimulationSettings {
     // smallest particle (LIGGGHTS warns above 0.2) unless explicitly allowed.
     double maxRayleighFraction = 0.2;
     bool allowLargeTimeStep = false;
+    // ... and not exceed this fraction of the Hertz collision time of two of the
+    // smallest particles meeting head-on at twice impactVelocity (LIGGGHTS'
+    // fix check/timestep/gran estimate).
+    double maxHertzFraction = 0.1;
+    double impactVelocity = 1.0;  // [m/s], the largest speed expected in the run
     // Systems of at least this many particles are sorted in space now and then
     // (see Simulation::updatePairList); smaller ones keep their order.
     std::size_t spatialSortMinParticles = 4096;
@@ -111,8 +116,14 @@ public:
     // Mean number of touching contacts per particle.
     double coordinationNumber() const;
 
-    // Largest time step the settings accept for the particles present.
+    // Largest time step the settings accept for the particles present, and the
+    // two limits it is the smaller of.
     double maxAllowedTimeStep() const;
+    struct TimeStepLimits {
+        double rayleigh;  // maxRayleighFraction x smallest Rayleigh time
+        double hertz;     // maxHertzFraction x smallest Hertz collision time
+    };
+    TimeStepLimits timeStepLimits(const std::vector<InsertedParticle>& adding = {}, int materialIndex = 0) const;
 
     // Restart: the whole state, contact history included.
     void writeRestart(const std::string& path) const;
