@@ -25,6 +25,7 @@
 
 #include "demLib/insertion.hpp"
 #include "demLib/simulation.hpp"
+#include "thread_count.hpp"
 #include "demLib/size_distribution.hpp"
 
 namespace {
@@ -35,27 +36,6 @@ constexpr double kPi = 3.14159265358979323846;
 
 dem::Material glass() { return {"glass", 5e6, 0.3, 2500.0}; }
 dem::Material steel() { return {"steel", 2e7, 0.3, 7800.0}; }
-
-// The tests that change the thread count put it back.
-class ThreadCount {
-public:
-    explicit ThreadCount(int n) {
-#ifdef _OPENMP
-        saved_ = omp_get_max_threads();
-        omp_set_num_threads(n);
-#else
-        (void)n;
-#endif
-    }
-    ~ThreadCount() {
-#ifdef _OPENMP
-        omp_set_num_threads(saved_);
-#endif
-    }
-
-private:
-    int saved_ = 1;
-};
 
 // A closed box [0, W] x [0, W] x [0, H] of six one-sided planes (steel), the
 // particles glass.  floorVelocity != 0 makes the floor slide in its own plane.

@@ -29,6 +29,7 @@
 #include "demLib/coarse_grain.hpp"
 #include "demLib/insertion.hpp"
 #include "demLib/simulation.hpp"
+#include "thread_count.hpp"
 #include "demLib/size_distribution.hpp"
 
 namespace {
@@ -41,26 +42,6 @@ constexpr double kGamma = 0.072;  // surface tension of water [N/m]
 // Sand and steel of paper Table 3.
 dem::Material sand() { return {"sand", 5e6, 0.3, 2650.0}; }
 dem::Material steel() { return {"steel", 7e10, 0.3, 7800.0}; }
-
-class ThreadCount {
-public:
-    explicit ThreadCount(int n) {
-#ifdef _OPENMP
-        saved_ = omp_get_max_threads();
-        omp_set_num_threads(n);
-#else
-        (void)n;
-#endif
-    }
-    ~ThreadCount() {
-#ifdef _OPENMP
-        omp_set_num_threads(saved_);
-#endif
-    }
-
-private:
-    int saved_ = 1;
-};
 
 // Paper eq 1-4 (θ = 0 unless given), written out from the paper.
 double richefeuForce(double r1, double r2, double gap, double volume, double theta = 0.0) {

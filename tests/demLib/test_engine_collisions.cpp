@@ -17,32 +17,11 @@
 
 #include "demLib/error.hpp"
 #include "demLib/simulation.hpp"
+#include "thread_count.hpp"
 
 namespace {
 
 using dem::Vec3;
-
-// These tests check physics, not threading: one thread, so that they run
-// alike (and fast) whatever OMP_NUM_THREADS says.  Restored afterwards.
-class OneThread {
-public:
-    OneThread() {
-#ifdef _OPENMP
-        saved_ = omp_get_max_threads();
-        omp_set_num_threads(1);
-#endif
-    }
-    ~OneThread() {
-#ifdef _OPENMP
-        omp_set_num_threads(saved_);
-#endif
-    }
-    OneThread(const OneThread&) = delete;
-    OneThread& operator=(const OneThread&) = delete;
-
-private:
-    int saved_ = 1;
-};
 
 // A soft "glass" (E reduced as usual in DEM): R = 1 mm gives a Rayleigh time
 // of 1.22e-4 s and a 1 m/s pair impact of 2.7e-4 s.

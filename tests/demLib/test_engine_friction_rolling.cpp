@@ -15,32 +15,11 @@
 #include <vector>
 
 #include "demLib/simulation.hpp"
+#include "thread_count.hpp"
 
 namespace {
 
 using dem::Vec3;
-
-// These tests check physics, not threading: one thread, so that they run
-// alike (and fast) whatever OMP_NUM_THREADS says.  Restored afterwards.
-class OneThread {
-public:
-    OneThread() {
-#ifdef _OPENMP
-        saved_ = omp_get_max_threads();
-        omp_set_num_threads(1);
-#endif
-    }
-    ~OneThread() {
-#ifdef _OPENMP
-        omp_set_num_threads(saved_);
-#endif
-    }
-    OneThread(const OneThread&) = delete;
-    OneThread& operator=(const OneThread&) = delete;
-
-private:
-    int saved_ = 1;
-};
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kRadius = 1e-3;
