@@ -10,9 +10,10 @@ postProcessing/:
                              the opening, with the two fitted lines:
                              - central angle: fit over x in [-R/2, R/2] (the paper's 'central
                                region', 33.8 deg measured, 32.9 deg simulated);
-                             - right-border angle: fit over the flank right of the bed's
-                               highest point in x > R/2, where the surface falls from 80 %
-                               to 20 % of its height there (paper: about 90 deg);
+                             - right-border angle: the bed's right edge (outermost particle
+                               per height band, |y| < R/4) fitted against height between 20 %
+                               and 80 % of the bed's height there; 90 deg = vertical
+                               (paper: about 90 deg);
   fillRatio.png              mass in the die / mass poured, vs time;
   sideView_filled.png, sideView_final.png   the bed from the side (like the paper's Fig. 5b);
   results.json / results.csv.
@@ -99,11 +100,12 @@ def main():
     x, h = profile.line_profile(pos, final.radius, (0, 0, 0), (1, 0, 0), (0, 0, 1), bin_width,
                                 extent=(-1.3 * radius, 1.3 * radius), band=radius / 4)
     centre = profile.fit_line(x, h, (-radius / 2, radius / 2))
+    # The right border stands close to vertical: measured from the bed's edge position vs
+    # height, which a height profile cannot resolve.
     right = None
     try:
-        xr, hr = x[x > radius / 2], h[x > radius / 2]
-        window = profile.flank_window(xr, hr, 0.2, 0.8)
-        right = profile.fit_line(x, h, window)
+        right = profile.edge_angle(pos, final.radius, (0, 0, 0), (1, 0, 0), (0, 0, 1), band=radius / 4,
+                                   bin_height=bin_width)
     except ValueError as e:
         print("dieFilling.py: right border:", e)
 
@@ -111,7 +113,7 @@ def main():
         f.write("x_mm,height_mm\n")
         for xi, hi in zip(x, h):
             f.write(f"{xi * 1e3:.4f},{'' if not np.isfinite(hi) else f'{hi * 1e3:.4f}'}\n")
-    profile_plot(os.path.join(out, "profile.png"), x, h, [centre] + ([right] if right else []),
+    profile_plot(os.path.join(out, "profile.png"), x, h, [centre],
                  f"bed profile after opening (plane of shoe motion): centre {centre['angle']:.1f} deg"
                  + (f", right border {right['angle']:.1f} deg" if right else ""))
     plots.curve(os.path.join(out, "fillRatio.png"), t, [fill], ["mass in die / mass poured"], "time [s]",
@@ -124,8 +126,9 @@ def main():
                          "description": f"fit over x in [{-radius / 2 * 1e3:.1f}, {radius / 2 * 1e3:.1f}] mm "
                                         "(paper: 33.8 measured, 32.9 simulated)"},
         "rightBorderAngle": {"value": round(right["angle"], 2) if right else None, "unit": "deg",
-                             "description": ("fit over x in [%.1f, %.1f] mm" % tuple(w * 1e3 for w in right["window"])
-                                             if right else "no flank found") + " (paper: about 90)"},
+                             "description": ("edge position vs height fitted over heights [%.1f, %.1f] mm "
+                                             "above the base" % tuple(w * 1e3 for w in right["window"])
+                                             if right else "no edge found") + " (paper: about 90)"},
         "massPoured": {"value": poured, "unit": "kg"},
         "massInDieFilled": {"value": mass_die_filled, "unit": "kg", "description": f"at t = {opening} s"},
         "fillRatioFilled": {"value": mass_die_filled / poured, "unit": "-"},

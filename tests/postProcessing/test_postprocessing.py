@@ -297,6 +297,24 @@ def command_line_tools():
 
 
 @test
+def edge_angle_is_recovered():
+    # A block of spheres whose right edge leans at a known angle (90 deg: a vertical
+    # wall of powder, as the die's right border; 60 and 45 deg: leaning edges).
+    rng = np.random.default_rng(7)
+    r = 5e-4
+    for angle in (90.0, 60.0, 45.0):
+        cot = 1.0 / np.tan(np.radians(angle))
+        h = rng.random(20000) * 0.02
+        edge = 0.02 - cot * h                      # edge position at height h
+        s = edge - r - rng.random(20000) * 0.02    # centres inside, outermost touching
+        s[:2000] = edge[:2000] - r                 # an outer layer exactly on the edge
+        p = np.column_stack([s, (rng.random(20000) - 0.5) * 0.004, h])
+        fit = profile.edge_angle(p, r, band=0.002, bin_height=1e-3)
+        check(f"edge at {angle:g} deg: fitted within 1 deg", abs(fit["angle"] - angle) < 1.0,
+              f"(got {fit['angle']:.2f} over heights {fit['window'][0]*1e3:.1f}-{fit['window'][1]*1e3:.1f} mm)")
+
+
+@test
 def plots_and_results():
     rng = np.random.default_rng(4)
     f = series.Frame.from_arrays(rng.random((300, 3)) * 0.01, 3e-4, velocity=rng.random((300, 3)))

@@ -90,3 +90,40 @@ def flank_window(x, h, low=0.2, high=0.8):
     if len(a) == 0 or len(b) == 0 or x[b[-1]] <= x[a[0]]:
         raise ValueError("profile has no flank between the requested height fractions")
     return float(x[a[0]]), float(x[b[-1]])
+
+
+def edge_angle(position, radius, origin=(0, 0, 0), direction=(1, 0, 0), up=(0, 0, 1), band=None,
+               bin_height=1e-3, low=0.2, high=0.8):
+    """Angle of a bed's edge on the `direction` side, measured from the edge position
+    versus height (a height profile cannot resolve an edge close to vertical).
+    Particles within `band` of the vertical plane through the line are binned by
+    height; per bin the edge is the outermost extent s + radius along `direction`.
+    A line s_edge = a + b h is fitted over the bins between `low` and `high` times
+    the height of the bed's top near the edge (particles in its outer half), and the
+    angle above the horizontal is atan(1/|b|): 90 deg for a vertical edge.
+    Returns dict(angle, slope_ds_dh, window (heights), points)."""
+    x = np.asarray(position, float) - np.asarray(origin, float)
+    d, n = unit(direction), unit(up)
+    r = np.asarray(radius, float) * np.ones(len(x))
+    s, h = x @ d, x @ n
+    keep = np.ones(len(x), bool)
+    if band is not None:
+        keep = np.abs(x @ np.cross(n, d)) <= band
+    s, h, r = s[keep], h[keep], r[keep]
+    outer = s > 0.5 * np.max(s + r)
+    top = float(np.max(h[outer] + r[outer]))
+    edges = np.arange(0.0, top + bin_height, bin_height)
+    centres, extent = [], []
+    for lo, hi in zip(edges[:-1], edges[1:]):
+        sel = (h >= lo) & (h < hi)
+        if np.any(sel):
+            centres.append(0.5 * (lo + hi))
+            extent.append(float(np.max(s[sel] + r[sel])))
+    centres, extent = np.array(centres), np.array(extent)
+    window = (low * top, high * top)
+    sel = (centres >= window[0]) & (centres <= window[1])
+    if np.count_nonzero(sel) < 3:
+        raise ValueError(f"edge fit window {window} holds fewer than 3 height bins")
+    b, _ = np.polyfit(centres[sel], extent[sel], 1)
+    return {"angle": float(np.degrees(np.arctan2(1.0, abs(b)))), "slope_ds_dh": float(b),
+            "window": [float(window[0]), float(window[1])], "points": int(np.count_nonzero(sel))}
