@@ -1,5 +1,6 @@
 #include "demLib/particle_particle_neighbor_list.hpp"
 
+#include "demLib/cell_bins.hpp"
 #include "demLib/parallel.hpp"
 
 #include <algorithm>
@@ -75,43 +76,15 @@ void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
     offsets_.assign(n + 1, 0);
     if (n == 0) return;
 
-    // Cell grid over the particles' bounding box, cells at least one interaction
-    // range wide so that only the 27 surrounding cells need a look.
-    Vec3 lo = positions[0], hi = positions[0];
+    // Cells at least one interaction range wide, so that only the 27
+    // surrounding cells need a look.
     double rMax = 0.0;
-    for (int i = 0; i < n; ++i) {
-        lo = lo.cwiseMin(positions[i]);
-        hi = hi.cwiseMax(positions[i]);
-        rMax = std::max(rMax, particles.radius[i]);
-    }
-    double cell = 2.0 * rMax + skin_ + extraRange_;
-    Vec3 extent = (hi - lo).cwiseMax(Vec3::Constant(cell));
-    // A scattered population (particles flying off) must not explode the grid.
-    const double maxCells = std::max(64.0, 4.0 * n);
-    while ((std::floor(extent.x() / cell) + 1) * (std::floor(extent.y() / cell) + 1) *
-               (std::floor(extent.z() / cell) + 1) > maxCells)
-        cell *= 1.26;
-    const int nx = static_cast<int>(extent.x() / cell) + 1;
-    const int ny = static_cast<int>(extent.y() / cell) + 1;
-    const int nz = static_cast<int>(extent.z() / cell) + 1;
-    const double invCell = 1.0 / cell;
-
-    std::vector<int> cellOf(n);
-    std::vector<int> cellStart(static_cast<std::size_t>(nx) * ny * nz + 1, 0);
-    for (int i = 0; i < n; ++i) {
-        const Vec3 r = (positions[i] - lo) * invCell;
-        const int cx = std::min(nx - 1, static_cast<int>(r.x()));
-        const int cy = std::min(ny - 1, static_cast<int>(r.y()));
-        const int cz = std::min(nz - 1, static_cast<int>(r.z()));
-        cellOf[i] = (cz * ny + cy) * nx + cx;
-        ++cellStart[cellOf[i] + 1];
-    }
-    for (std::size_t c = 1; c < cellStart.size(); ++c) cellStart[c] += cellStart[c - 1];
-    std::vector<int> cellParticles(n);
-    {
-        std::vector<int> fill(cellStart.begin(), cellStart.end() - 1);
-        for (int i = 0; i < n; ++i) cellParticles[fill[cellOf[i]]++] = i;  // ascending i per cell
-    }
+    for (int i = 0; i < n; ++i) rMax = std::max(rMax, particles.radius[i]);
+    const CellBins bins = binIntoCells(positions, 2.0 * rMax + skin_ + extraRange_);
+    const int nx = bins.nx, ny = bins.ny, nz = bins.nz;
+    const std::vector<int>& cellOf = bins.cellOf;
+    const std::vector<int>& cellStart = bins.cellStart;
+    const std::vector<int>& cellParticles = bins.particles;
 
     // Each thread lists a contiguous block of i; blocks are joined in order, so
     // the list does not depend on the thread count.
