@@ -74,7 +74,7 @@ Foam::diefill::particleFluidState Foam::diefill::demCoupling::state
     const auto& v = particles.velocity[i];
 
     particleFluidState s;
-    s.diameter = 2*r;
+    s.diameter = 2*r/coarseGrainFactor_;
     s.volume = 4.0/3.0*constant::mathematical::pi*pow3(r);
     s.particleVelocity = vector(v.x(), v.y(), v.z());
     s.fluidVelocity = fluidVelocity;
@@ -137,6 +137,7 @@ Foam::diefill::demCoupling::demCoupling
     alphaMin_(dict_.get<scalar>("alphaMin")),
     smoothingLength_(dict_.getOrDefault<scalar>("smoothingLength", 0)),
     g_("g", dimAcceleration, Zero),
+    coarseGrainFactor_(1),
     K_(),
     nLost_(0),
     restartForces_(false)
@@ -207,6 +208,15 @@ Foam::diefill::demCoupling::demCoupling
             << " s, constant/demProperties) before the air (endTime "
             << mesh_.time().endTime().value() << " s, system/controlDict)."
             << exit(FatalError);
+    }
+
+    coarseGrainFactor_ = setup.coarseGrain.factor;
+    if (coarseGrainFactor_ != 1)
+    {
+        Info<< "    coarse grain: factor " << coarseGrainFactor_
+            << ", drag of parcels = " << coarseGrainFactor_
+            << "^3 x drag of primary particles of diameter D/"
+            << coarseGrainFactor_ << endl;
     }
 
     // Each rank runs the same DEM; only the master's output goes to the case

@@ -31,7 +31,9 @@ Foam::scalar Foam::diefill::DiFelice::beta(const particleFluidState& s) const
     const scalar Re = max(s.reynolds(), VSMALL);
     const scalar chi = 3.7 - 0.65*exp(-0.5*sqr(1.5 - log10(Re)));
 
-    const scalar area = 0.25*constant::mathematical::pi*sqr(d);
+    // Projected area of the particles of diameter d in the volume V_p:
+    // pi d^2/4 times V_p/(pi d^3/6) (one particle unless coarse grained)
+    const scalar area = 1.5*s.volume/d;
 
     // F = 1/2 C_D rho A alpha^2 |u-v| (u-v) alpha^-chi
     return 0.5*sqr(sqrtCdSlip)*s.fluidDensity*area*pow(alpha, 2 - chi);
