@@ -36,6 +36,7 @@ Description
 #include "zeroGradientFvPatchFields.H"
 
 #include "demCoupling.H"
+#include "progressReport.H"
 
 // * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * //
 
@@ -79,6 +80,9 @@ int main(int argc, char *argv[])
     // * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * //
 
     Info<< "\nStarting time loop\n" << endl;
+
+    // A line with the ETA every 30 s of wall time (long die-filling runs)
+    diefill::progressReport progress(runTime);
 
     while (runTime.run())
     {
@@ -130,6 +134,8 @@ int main(int argc, char *argv[])
         runTime.write();
 
         runTime.printExecutionTime(Info);
+
+        progress.update();
     }
 
     coupling.finish();
