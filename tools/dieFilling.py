@@ -16,7 +16,10 @@ postProcessing/:
                                (paper: about 90 deg);
   fillRatio.png              mass in the die / mass poured, vs time;
   sideView_filled.png, sideView_final.png   the bed from the side (like the paper's Fig. 5b);
-  results.json / results.csv.
+  results.json / results.csv, with the fill times (die mass reaching 50 % and 90 % of the
+                             mass poured) and, in a run with air (diefillFoam), the mean
+                             pressure on the aeration plate while air is blown through the
+                             shoe's bed and the volume of air that left the die.
 Heights are measured from the die base (z = -H)."""
 import argparse
 import os
@@ -48,6 +51,68 @@ def profile_plot(path, x, h, fits, title):
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
+
+
+def first_time_reaching(t, values, level):
+    """Linear interpolation of the first time values >= level (None if never)."""
+    above = np.nonzero(values >= level)[0]
+    if len(above) == 0:
+        return None
+    k = int(above[0])
+    if k == 0:
+        return float(t[0])
+    v0, v1 = values[k - 1], values[k]
+    return float(t[k - 1] + (level - v0) / (v1 - v0) * (t[k] - t[k - 1]))
+
+
+def read_function_object(case, name):
+    """Columns of postProcessing/<name>/<start>/surfaceFieldValue.dat (all start times)."""
+    root = os.path.join(case, "postProcessing", name)
+    rows = []
+    if os.path.isdir(root):
+        for start in sorted(os.listdir(root), key=float):
+            path = os.path.join(root, start, "surfaceFieldValue.dat")
+            if os.path.isfile(path):
+                for line in open(path):
+                    if line.startswith("#") or not line.strip():
+                        continue
+                    rows.append([float(x) for x in line.replace("(", " ").replace(")", " ").split()])
+    return np.array(rows) if rows else None
+
+
+def air_results(case, rho, until):
+    """Aeration pressure and air leaving the die, from the function objects of the air run."""
+    res = {}
+    aeration = read_function_object(case, "aerationPressure")
+    if aeration is not None:
+        t, p, uz = aeration[:, 0], aeration[:, 1] * rho, aeration[:, 4]
+        blowing = uz > 0.5 * np.max(uz) if np.max(uz) > 0 else np.zeros(len(t), bool)
+        if blowing.any():
+            stop = float(t[blowing].max())
+            # the second half of the blowing (the bed in the shoe has formed), and the
+            # 50 ms after it stopped (the air's own hydrostatic pressure on the plate)
+            late = blowing & (t >= 0.5 * stop)
+            after = (t > stop + 0.01) & (t <= stop + 0.05)
+            res["aerationPressure"] = {"value": round(float(np.mean(p[late])), 3), "unit": "Pa",
+                                       "description": "mean pressure on the aeration plate (relative to the room) "
+                                                      "over the second half of the aeration, at superficial "
+                                                      "velocity %.3g m/s" % float(np.max(uz))}
+            if after.any():
+                res["aerationOverpressure"] = {"value": round(float(np.mean(p[late]) - np.mean(p[after])), 3),
+                                               "unit": "Pa",
+                                               "description": "aerationPressure less the plate pressure in the "
+                                                              "50 ms after the blowing stopped"}
+    die_air = read_function_object(case, "dieAir")
+    if die_air is not None and len(die_air) > 1:
+        t, q = die_air[:, 0], die_air[:, 1]
+        keep = t <= until + 1e-9
+        t, q = t[keep], q[keep]
+        volume = float(np.sum(0.5 * (q[1:] + q[:-1]) * np.diff(t)))
+        res["airVolumeOutOfDie"] = {"value": volume, "unit": "m3",
+                                    "description": "net volume of air that left the die through its opening "
+                                                   "until t = %g s (the die walls are sealed: it equals the "
+                                                   "volume of powder that entered)" % until}
+    return res
 
 
 def die_geometry(case):
@@ -91,6 +156,10 @@ def main():
     lost_before_opening = float(s["lostMass"][before][-1])
     lost_at_opening = lost_total - lost_before_opening
     fill = summary.fill_ratio(s["mass_die"], poured)
+    t50 = first_time_reaching(t, np.asarray(fill), 0.5)
+    t90 = first_time_reaching(t, np.asarray(fill), 0.9)
+    with_air = os.path.isdir(os.path.join(case, "constant", "polyMesh"))
+    wet = "cohesion" in foamdict.read_case(case)
 
     final = series.read_frame(frames[-1][1])
     filled = series.read_frame(min(frames, key=lambda e: abs(e[0] - opening))[1])
@@ -100,6 +169,8 @@ def main():
     x, h = profile.line_profile(pos, final.radius, (0, 0, 0), (1, 0, 0), (0, 0, 1), bin_width,
                                 extent=(-1.3 * radius, 1.3 * radius), band=radius / 4)
     centre = profile.fit_line(x, h, (-radius / 2, radius / 2))
+    border = (x >= 0.8 * radius) & (x <= radius) & np.isfinite(h)
+    right_height = float(np.mean(h[border])) if border.any() else 0.0
     # The right border stands close to vertical: measured from the bed's edge position vs
     # height, which a height profile cannot resolve.
     right = None
@@ -129,6 +200,9 @@ def main():
                              "description": ("edge position vs height fitted over heights [%.1f, %.1f] mm "
                                              "above the base" % tuple(w * 1e3 for w in right["window"])
                                              if right else "no edge found") + " (paper: about 90)"},
+        "rightBorderHeight": {"value": round(right_height * 1e3, 3), "unit": "mm",
+                              "description": "mean bed height above the base over x in [0.8 R, R] after "
+                                             "the opening (a bed that stands keeps its height to its edge)"},
         "massPoured": {"value": poured, "unit": "kg"},
         "massInDieFilled": {"value": mass_die_filled, "unit": "kg", "description": f"at t = {opening} s"},
         "fillRatioFilled": {"value": mass_die_filled / poured, "unit": "-"},
@@ -137,13 +211,36 @@ def main():
         "fractionLostAtOpening": {"value": lost_at_opening / mass_die_filled if mass_die_filled > 0 else None,
                                   "unit": "-", "description": "of the mass in the die (paper: 0.10 simulated, 0.02 measured)"},
         "openingStart": {"value": opening, "unit": "s"},
+        "fillTime50": {"value": t50, "unit": "s", "description": "die holds 50 % of the mass poured"},
+        "fillTime90": {"value": t90, "unit": "s", "description": "die holds 90 % of the mass poured"},
+        "air": {"value": with_air, "unit": "-", "description": "air solved with the powder (diefillFoam)"},
+        "wet": {"value": wet, "unit": "-", "description": "capillary cohesion (5 % water)"},
     }
+    if with_air:
+        rho = float(foamdict.read(os.path.join(case, "constant", "transportProperties"))["rho"])
+        res.update(air_results(case, rho, opening))
+        density = float(foamdict.read_case(case)["materials"]["sand"]["density"])
+        res["shoeBedWeightPerArea"] = {"value": round(poured * 9.81 / (np.pi * radius**2), 3), "unit": "Pa",
+                                       "description": "weight of the powder in the shoe over the shoe's "
+                                                      "cross-section (the shoe and the die have one radius)"}
+        res["solidVolumeInDieFilled"] = {"value": mass_die_filled / density, "unit": "m3",
+                                         "description": f"mass in the die / {density:g} kg/m3 at t = {opening} s"}
     if a.runTime is not None:
         res["runTime"] = {"value": a.runTime, "unit": "s", "description": "wall time of demRun"}
     results.write(case, res)
-    print("dieFilling: central angle %.1f deg, right border %s deg, fill ratio %.3f, lost at opening %.1f %%"
-          % (centre["angle"], f"{right['angle']:.1f}" if right else "n/a", mass_die_filled / poured,
-             100 * lost_at_opening / max(mass_die_filled, 1e-30)))
+    print("dieFilling (%s, %s): central angle %.1f deg, right border %s deg, fill ratio %.3f, "
+          "lost at opening %.1f %%, die 50 %% / 90 %% full at t = %s / %s s"
+          % ("wet" if wet else "dry", "air" if with_air else "vacuum", centre["angle"],
+             f"{right['angle']:.1f}" if right else "n/a", mass_die_filled / poured,
+             100 * lost_at_opening / max(mass_die_filled, 1e-30),
+             f"{t50:.3f}" if t50 is not None else "n/a", f"{t90:.3f}" if t90 is not None else "n/a"))
+    if "aerationOverpressure" in res:
+        print("    aeration: %.2f Pa over the air's own pressure on the plate under the shoe's bed "
+              "(bed weight per area %.1f Pa)" % (res["aerationOverpressure"]["value"],
+                                                res["shoeBedWeightPerArea"]["value"]))
+    if "airVolumeOutOfDie" in res:
+        print("    air out of the die until the opening: %.3g cm3; powder volume in the die: %.3g cm3"
+              % (res["airVolumeOutOfDie"]["value"] * 1e6, res["solidVolumeInDieFilled"]["value"] * 1e6))
     return 0
 
 

@@ -8,6 +8,14 @@
 #                               'rolling <model>' set (-rolling)
 #   tutorial_run_demRun         demRun (or $DEMRUN) in the case (log.demRun), wall time in TUTORIAL_DEM_SECONDS
 #   tutorial_clean              removes the results and restores constant/demProperties
+# Cases with air (diefillFoam; dieFilling):
+#   tutorial_swap_quick SRC DST  DST from SRC with the '// @quick ...' lines swapped in (-quick)
+#   tutorial_prepare_air SCALE  the air mesh (writeAirMesh -scale SCALE, blockMesh, topoSet,
+#                               subsetMesh, createPatch) and 0/ from 0.orig/; when time folders
+#                               and the mesh exist already, keeps them: the run continues
+#   tutorial_run_diefillFoam    diefillFoam in the case (log.diefillFoam), wall time in
+#                               TUTORIAL_DEM_SECONDS
+#   tutorial_clean_air          removes the mesh, 0/, the time folders and the air's outputs
 
 tutorial_usage() { awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; }
 
@@ -30,16 +38,21 @@ tutorial_parse_args() {
     done
 }
 
-tutorial_prepare() {
-    local props=constant/demProperties
-    [ -f "$props.orig" ] || cp "$props" "$props.orig"
+tutorial_swap_quick() {
+    local src=$1 dst=$2
     if [ "$QUICK" = 1 ]; then
         # '<full text>   // @quick <quick text>'  ->  '<quick text>   // quick setting; full: <full text>'
         sed -E 's#^([[:space:]]*)([^/[:space:]].*[^[:space:]])[[:space:]]*// @quick (.*)$#\1\3   // quick setting; full: \2#' \
-            "$props.orig" > "$props"
+            "$src" > "$dst"
     else
-        cp "$props.orig" "$props"
+        cp "$src" "$dst"
     fi
+}
+
+tutorial_prepare() {
+    local props=constant/demProperties
+    [ -f "$props.orig" ] || cp "$props" "$props.orig"
+    tutorial_swap_quick "$props.orig" "$props"
     if [ -n "$ROLLING" ]; then
         sed -i -E "s#(contactModel[^}]*rolling )[a-z0-9]+;#\1$ROLLING;#" "$props"
     fi
@@ -60,6 +73,51 @@ tutorial_run_demRun() {
         exit "$status"
     fi
     echo "    demRun: ok (${TUTORIAL_DEM_SECONDS} s, log.demRun)"
+}
+
+tutorial_prepare_air() {
+    local scale=$1 tool
+    [ -f system/controlDict.orig ] || cp system/controlDict system/controlDict.orig
+    tutorial_swap_quick system/controlDict.orig system/controlDict
+    if [ -d constant/polyMesh ] && [ -d 0 ] && ls -d [0-9]* 2>/dev/null | grep -qv '^0$'; then
+        echo "    air: continuing from t = $(ls -d [0-9]* | sort -g | tail -1) s (mesh and fields kept)"
+        return 0
+    fi
+    rm -rf 0 constant/polyMesh
+    "$DIEFILL_PYTHON" ./writeAirMesh -scale "$scale" > log.writeAirMesh
+    local steps=("blockMesh:blockMesh" "topoSet:topoSet" "subsetMesh:subsetMesh air -patch walls -overwrite"
+                 "topoSet.aeration:topoSet -dict system/topoSetDict.aeration" "createPatch:createPatch -overwrite")
+    for tool in "${steps[@]}"; do
+        # shellcheck disable=SC2086
+        if ! ${tool#*:} > "log.${tool%%:*}" 2>&1; then
+            echo "$(basename "$PWD"): '${tool#*:}' failed; last lines of log.${tool%%:*}:" >&2
+            tail -n 20 "log.${tool%%:*}" >&2
+            exit 1
+        fi
+    done
+    mkdir -p 0
+    for f in 0.orig/*; do tutorial_swap_quick "$f" "0/$(basename "$f")"; done
+    echo "    air mesh: $(sed -n 's/^writeAirMesh: //p' log.writeAirMesh)"
+}
+
+tutorial_run_diefillFoam() {
+    local start=$SECONDS status=0
+    [ -d dem/restart ] && ls -d [0-9]* 2>/dev/null | grep -qv '^0$' || rm -rf dem
+    OMP_NUM_THREADS=$THREADS OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-passive} diefillFoam >> log.diefillFoam 2>&1 || status=$?
+    TUTORIAL_DEM_SECONDS=$((SECONDS - start))
+    if [ "$status" -ne 0 ]; then
+        echo "$(basename "$PWD"): diefillFoam failed (exit $status); last lines of log.diefillFoam:" >&2
+        tail -n 30 log.diefillFoam >&2
+        exit "$status"
+    fi
+    echo "    diefillFoam: ok (${TUTORIAL_DEM_SECONDS} s, log.diefillFoam)"
+}
+
+tutorial_clean_air() {
+    rm -rf 0 constant/polyMesh [1-9]* 0.[0-9]* processor* postProcessing log.* \
+        system/blockMeshDict system/topoSetDict system/topoSetDict.aeration system/createPatchDict
+    [ -f system/controlDict.orig ] && mv system/controlDict.orig system/controlDict
+    return 0
 }
 
 tutorial_clean() {
