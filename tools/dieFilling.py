@@ -16,6 +16,8 @@ postProcessing/:
                                (paper: about 90 deg);
   fillRatio.png              mass in the die / mass poured, vs time;
   sideView_filled.png, sideView_final.png   the bed from the side (like the paper's Fig. 5b);
+  air.png                    (runs with air) the pressure on the aeration plate while the shoe's
+                             bed is conditioned; the air leaving the die vs the powder entering;
   results.json / results.csv, with the fill times (die mass reaching 50 % and 90 % of the
                              mass poured) and, in a run with air (diefillFoam), the mean
                              pressure on the aeration plate while air is blown through the
@@ -80,9 +82,11 @@ def read_function_object(case, name):
     return np.array(rows) if rows else None
 
 
-def air_results(case, rho, until):
-    """Aeration pressure and air leaving the die, from the function objects of the air run."""
+def air_results(case, rho, until, out=None, summary_t=None, solid_volume_in_die=None):
+    """Aeration pressure and air leaving the die, from the function objects of the air run;
+    with out: air.png (plate pressure, and air out of the die vs powder volume in it)."""
     res = {}
+    curves = {}
     aeration = read_function_object(case, "aerationPressure")
     if aeration is not None:
         t, p, uz = aeration[:, 0], aeration[:, 1] * rho, aeration[:, 4]
@@ -97,6 +101,7 @@ def air_results(case, rho, until):
                                        "description": "mean pressure on the aeration plate (relative to the room) "
                                                       "over the second half of the aeration, at superficial "
                                                       "velocity %.3g m/s" % float(np.max(uz))}
+            curves["aeration"] = (t, p)
             if after.any():
                 res["aerationOverpressure"] = {"value": round(float(np.mean(p[late]) - np.mean(p[after])), 3),
                                                "unit": "Pa",
@@ -105,6 +110,8 @@ def air_results(case, rho, until):
     die_air = read_function_object(case, "dieAir")
     if die_air is not None and len(die_air) > 1:
         t, q = die_air[:, 0], die_air[:, 1]
+        cumulative = np.concatenate(([0.0], np.cumsum(0.5 * (q[1:] + q[:-1]) * np.diff(t))))
+        curves["dieAir"] = (t, cumulative)
         keep = t <= until + 1e-9
         t, q = t[keep], q[keep]
         volume = float(np.sum(0.5 * (q[1:] + q[:-1]) * np.diff(t)))
@@ -112,7 +119,38 @@ def air_results(case, rho, until):
                                     "description": "net volume of air that left the die through its opening "
                                                    "until t = %g s (the die walls are sealed: it equals the "
                                                    "volume of powder that entered)" % until}
+    if out is not None and curves:
+        air_plot(os.path.join(out, "air.png"), curves, summary_t, solid_volume_in_die, until)
     return res
+
+
+def air_plot(path, curves, summary_t, solid_volume_in_die, opening):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, 2, figsize=(10, 3.5))
+    if "aeration" in curves:
+        t, p = curves["aeration"]
+        axes[0].plot(t, p, lw=1)
+        axes[0].set_xlim(0, min(t[-1], 2 * max(0.2, t[np.argmax(p)] + 0.2)))
+    axes[0].set_xlabel("time [s]")
+    axes[0].set_ylabel("pressure on the aeration plate [Pa]")
+    axes[0].set_title("conditioning: air blown through the shoe's bed", fontsize=9)
+    if "dieAir" in curves:
+        t, v = curves["dieAir"]
+        axes[1].plot(t, v * 1e6, lw=1.5, label="air out of the die (through its opening)")
+    if summary_t is not None and solid_volume_in_die is not None:
+        axes[1].plot(summary_t, solid_volume_in_die * 1e6, "--", lw=1.5, label="powder volume in the die")
+    axes[1].axvline(opening, color="k", ls=":", lw=1, label="die opening starts")
+    axes[1].set_xlabel("time [s]")
+    axes[1].set_ylabel("volume [cm$^3$]")
+    axes[1].set_title("the sealed die: displaced air vs powder in", fontsize=9)
+    axes[1].legend(fontsize=8)
+    for ax in axes:
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
 
 
 def die_geometry(case):
@@ -218,8 +256,8 @@ def main():
     }
     if with_air:
         rho = float(foamdict.read(os.path.join(case, "constant", "transportProperties"))["rho"])
-        res.update(air_results(case, rho, opening))
         density = float(foamdict.read_case(case)["materials"]["sand"]["density"])
+        res.update(air_results(case, rho, opening, out, t, np.asarray(s["mass_die"]) / density))
         res["shoeBedWeightPerArea"] = {"value": round(poured * 9.81 / (np.pi * radius**2), 3), "unit": "Pa",
                                        "description": "weight of the powder in the shoe over the shoe's "
                                                       "cross-section (the shoe and the die have one radius)"}

@@ -75,12 +75,15 @@ tutorial_run_demRun() {
     echo "    demRun: ok (${TUTORIAL_DEM_SECONDS} s, log.demRun)"
 }
 
+# Time folders of the air after 0, in order
+tutorial_air_times() { ls -d [0-9]* 2>/dev/null | grep -E '^[0-9]+(\.[0-9]+)?(e[+-]?[0-9]+)?$' | grep -v '^0$' | sort -g; }
+
 tutorial_prepare_air() {
     local scale=$1 tool
     [ -f system/controlDict.orig ] || cp system/controlDict system/controlDict.orig
     tutorial_swap_quick system/controlDict.orig system/controlDict
-    if [ -d constant/polyMesh ] && [ -d 0 ] && ls -d [0-9]* 2>/dev/null | grep -qv '^0$'; then
-        echo "    air: continuing from t = $(ls -d [0-9]* | sort -g | tail -1) s (mesh and fields kept)"
+    if [ -d constant/polyMesh ] && [ -d 0 ] && [ -n "$(tutorial_air_times)" ]; then
+        echo "    air: continuing from t = $(tutorial_air_times | tail -1) s (mesh and fields kept)"
         return 0
     fi
     rm -rf 0 constant/polyMesh
@@ -95,6 +98,7 @@ tutorial_prepare_air() {
             exit 1
         fi
     done
+    touch case.foam     # for ParaView's OpenFOAM reader
     mkdir -p 0
     for f in 0.orig/*; do tutorial_swap_quick "$f" "0/$(basename "$f")"; done
     echo "    air mesh: $(sed -n 's/^writeAirMesh: //p' log.writeAirMesh)"
@@ -102,7 +106,7 @@ tutorial_prepare_air() {
 
 tutorial_run_diefillFoam() {
     local start=$SECONDS status=0
-    [ -d dem/restart ] && ls -d [0-9]* 2>/dev/null | grep -qv '^0$' || rm -rf dem
+    [ -d dem/restart ] && [ -n "$(tutorial_air_times)" ] || rm -rf dem
     OMP_NUM_THREADS=$THREADS OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-passive} diefillFoam >> log.diefillFoam 2>&1 || status=$?
     TUTORIAL_DEM_SECONDS=$((SECONDS - start))
     if [ "$status" -ne 0 ]; then
@@ -114,7 +118,7 @@ tutorial_run_diefillFoam() {
 }
 
 tutorial_clean_air() {
-    rm -rf 0 constant/polyMesh [1-9]* 0.[0-9]* processor* postProcessing log.* \
+    rm -rf 0 constant/polyMesh [1-9]* 0.[0-9]* processor* postProcessing log.* case.foam \
         system/blockMeshDict system/topoSetDict system/topoSetDict.aeration system/createPatchDict
     [ -f system/controlDict.orig ] && mv system/controlDict.orig system/controlDict
     return 0
