@@ -153,6 +153,15 @@ def air_plot(path, curves, summary_t, solid_volume_in_die, opening):
     plt.close(fig)
 
 
+def shoe_pass_window(case):
+    """(start, end) of the shoe's motion (walls/shoe/motion in demProperties), or None."""
+    shoe = foamdict.read_case(case)["walls"].get("shoe", {})
+    segments = [s for s in shoe.get("motion", {}).values() if isinstance(s, dict)]
+    if not segments:
+        return None
+    return min(float(s["start"]) for s in segments), max(float(s["end"]) for s in segments)
+
+
 def die_geometry(case):
     d = foamdict.read_case(case)
     wall = d["walls"]["dieWall"]
@@ -194,6 +203,9 @@ def main():
     lost_before_opening = float(s["lostMass"][before][-1])
     lost_at_opening = lost_total - lost_before_opening
     fill = summary.fill_ratio(s["mass_die"], poured)
+    shoe_pass = shoe_pass_window(case)
+    during = (t >= shoe_pass[0]) & (t <= shoe_pass[1]) if shoe_pass else np.zeros(len(t), bool)
+    mean_fill_pass = float(np.mean(np.asarray(fill)[during])) if during.any() else None
     t50 = first_time_reaching(t, np.asarray(fill), 0.5)
     t90 = first_time_reaching(t, np.asarray(fill), 0.9)
     with_air = os.path.isdir(os.path.join(case, "constant", "polyMesh"))
@@ -251,6 +263,9 @@ def main():
         "openingStart": {"value": opening, "unit": "s"},
         "fillTime50": {"value": t50, "unit": "s", "description": "die holds 50 % of the mass poured"},
         "fillTime90": {"value": t90, "unit": "s", "description": "die holds 90 % of the mass poured"},
+        "meanFillRatioDuringPass": {"value": mean_fill_pass, "unit": "-",
+                                    "description": "fill ratio averaged over the shoe's pass %s s (lower: the "
+                                                   "die fills later)" % (list(shoe_pass) if shoe_pass else "")},
         "air": {"value": with_air, "unit": "-", "description": "air solved with the powder (diefillFoam)"},
         "wet": {"value": wet, "unit": "-", "description": "capillary cohesion (5 % water)"},
     }
