@@ -2,11 +2,13 @@
 
 #include "demLib/parallel.hpp"
 
+#include <algorithm>
+
 namespace dem {
 
-void kickAndDrift(ParticleStore& p, double dt) {
+void kickAndDrift(ParticleStore& p, double dt, std::size_t count) {
     const double half = 0.5 * dt;
-    const std::size_t n = p.size();
+    const std::size_t n = std::min(count, p.size());
 #pragma omp parallel for schedule(static) num_threads(threadsFor(n, lightLoopParticlesPerThread))
     for (std::size_t i = 0; i < n; ++i) {
         p.velocity[i] += (half * p.invMass[i]) * p.force[i];
@@ -15,9 +17,9 @@ void kickAndDrift(ParticleStore& p, double dt) {
     }
 }
 
-void kick(ParticleStore& p, double dt) {
+void kick(ParticleStore& p, double dt, std::size_t count) {
     const double half = 0.5 * dt;
-    const std::size_t n = p.size();
+    const std::size_t n = std::min(count, p.size());
 #pragma omp parallel for schedule(static) num_threads(threadsFor(n, lightLoopParticlesPerThread))
     for (std::size_t i = 0; i < n; ++i) {
         p.velocity[i] += (half * p.invMass[i]) * p.force[i];

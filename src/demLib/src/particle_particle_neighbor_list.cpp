@@ -33,8 +33,8 @@ bool ParticleParticleNeighborList::needsRebuild(const ParticleStore& particles) 
     return rebuild;
 }
 
-void ParticleParticleNeighborList::build(const ParticleStore& particles) {
-    buildFrom(particles, particles.position);
+void ParticleParticleNeighborList::build(const ParticleStore& particles, std::size_t listedRows) {
+    buildFrom(particles, particles.position, listedRows);
     positionAtBuild_ = particles.position;
     ++buildCount_;
 }
@@ -61,8 +61,10 @@ bool ParticleParticleNeighborList::setState(int i, int j, const PairState& s) {
 }
 
 void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
-                                             const std::vector<Vec3>& positions) {
+                                             const std::vector<Vec3>& positions, std::size_t listedRows) {
     const int n = static_cast<int>(particles.size());
+    // Rows listed (first particles of pairs): all but MPI ghosts.
+    const int rows = static_cast<int>(std::min(listedRows, particles.size()));
     std::vector<int> oldOffsets;
     std::vector<int> oldNeighbors;
     std::vector<PairState> oldState;
@@ -88,7 +90,7 @@ void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
 
     // Each thread lists a contiguous block of i; blocks are joined in order, so
     // the list does not depend on the thread count.
-    const int threads = threadsFor(n, heavyLoopParticlesPerThread);
+    const int threads = threadsFor(rows, heavyLoopParticlesPerThread);
     std::vector<std::vector<int>> blockNeighbors(threads);
     std::vector<int> count(n, 0);
     const double reach = skin_ + extraRange_;
@@ -99,8 +101,8 @@ void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
 #else
         const int t = 0;
 #endif
-        const int begin = static_cast<int>(static_cast<long>(n) * t / threads);
-        const int end = static_cast<int>(static_cast<long>(n) * (t + 1) / threads);
+        const int begin = static_cast<int>(static_cast<long>(rows) * t / threads);
+        const int end = static_cast<int>(static_cast<long>(rows) * (t + 1) / threads);
         std::vector<int>& out = blockNeighbors[t];
         out.reserve(static_cast<std::size_t>(end - begin) * 8);
         std::vector<int> mine;

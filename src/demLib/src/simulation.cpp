@@ -94,6 +94,18 @@ void Simulation::insert(const std::vector<InsertedParticle>& inserted, int mater
     // insertion leaves the simulation as it was.
     requireTimeStepBelow(settings_, timeStepLimits(inserted, materialIndex), context);
     const double density = materials_[materialIndex].density;
+    if (decomposition_) {
+        // Every rank is given the same particles and numbers them alike; each
+        // keeps the ones in its slab, after its owned ones (ghosts go first).
+        decomposition_->dropGhosts(particles_, pairs_, wallContacts_);
+        for (const InsertedParticle& q : inserted) {
+            const std::int64_t id = nextId_++;
+            if (decomposition_->owns(q.position))
+                particles_.add(id, q.position, velocity, q.radius, density, materialIndex);
+        }
+        forcesValid_ = false;
+        return;
+    }
     particles_.reserve(particles_.size() + inserted.size());
     for (const InsertedParticle& q : inserted)
         particles_.add(nextId_++, q.position, velocity, q.radius, density, materialIndex);
@@ -122,7 +134,24 @@ double Simulation::maxAllowedTimeStep() const {
     return std::min(limits.rayleigh, limits.hertz);
 }
 
+void Simulation::setDecomposition(std::shared_ptr<GhostExchange> decomposition) {
+    if (!particles_.empty() || nextId_ != 0)
+        throw InputError(settings_.source + ": the domain decomposition must be set before any particle is inserted");
+    if (settings_.forces.cohesion == CohesionModel::Capillary)
+        throw InputError(settings_.source + ": capillary cohesion is not available with MPI domain decomposition "
+                                            "yet (the liquid is shared over all bridges of the run); expected "
+                                            "'cohesion none' or a single process");
+    decomposition_ = std::move(decomposition);
+    forcesValid_ = false;
+}
+
+void Simulation::requireNoDecomposition(const std::string& what) const {
+    if (decomposition_)
+        throw InputError(settings_.source + ": " + what + " is not available with MPI domain decomposition yet");
+}
+
 void Simulation::setWaterContent(double w) {
+    requireNoDecomposition("setWaterContent (capillary liquid)");
     const double volume = waterVolumeFromContent(w, particles_.totalMass(), 1000.0, settings_.source);
     liquid_.waterContent = w;
     // Water added for new particles waits in the pool until the next update.
@@ -167,17 +196,30 @@ double Simulation::liquidCoordinationNumber() const {
 }
 
 double Simulation::coordinationNumber() const {
-    return particles_.empty() ? 0.0 : 2.0 * static_cast<double>(last_.contacts.touchingPairs) / particles_.size();
+    const std::size_t n = ownedCount();
+    return n == 0 ? 0.0 : 2.0 * static_cast<double>(last_.contacts.touchingPairs) / n;
 }
 
 void Simulation::removeLostParticles() {
     last_.lostThisStep = 0;
     if (!settings_.domain) return;
+    // With a decomposition each rank removes its own particles; ghosts are
+    // dropped first (their owners remove them), so the lists are empty below.
+    const auto isLost = [&](std::size_t i) {
+        return !settings_.domain->contains(particles_.position[i]) || !particles_.position[i].allFinite();
+    };
+    if (decomposition_) {
+        const std::size_t owned = ownedCount();
+        std::size_t i = 0;
+        while (i < owned && !isLost(i)) ++i;
+        if (i == owned) return;
+        decomposition_->dropGhosts(particles_, pairs_, wallContacts_);
+    }
     const std::size_t n = particles_.size();
     std::vector<char> keep(n, 1);
     std::size_t out = 0;
     for (std::size_t i = 0; i < n; ++i) {
-        if (!settings_.domain->contains(particles_.position[i]) || !particles_.position[i].allFinite()) {
+        if (isLost(i)) {
             keep[i] = 0;
             ++out;
             lostMass_ += particles_.mass[i];
@@ -203,8 +245,15 @@ void Simulation::removeLostParticles() {
 }
 
 void Simulation::updatePairList() {
+    if (decomposition_) {
+        // History to the id-keyed stash, ghosts away, particles to their owners.
+        decomposition_->dropGhosts(particles_, pairs_, wallContacts_);
+        decomposition_->migrate(particles_);
+    }
     double rMax = 0.0;
     for (double r : particles_.radius) rMax = std::max(rMax, r);
+    // The same skin on every rank as in a one-rank run.
+    if (decomposition_) rMax = decomposition_->communicator().max(rMax);
     double extra = 0.0;
     if (liquidNetwork_ && !particles_.empty()) {
         // Bridges can only form between listed pairs: reach out to the debonding
@@ -225,7 +274,15 @@ void Simulation::updatePairList() {
         wallContacts_.remap(oldToNew);
     }
     pairs_.setRanges(skin, extra);
-    pairs_.build(particles_);
+    if (decomposition_) {
+        // A listed pair is closer than r_i + r_j + skin + extra <= 2 r_max +
+        // skin + extra: ghosts out to that distance from the slab suffice.
+        decomposition_->appendGhosts(particles_, 2.0 * rMax + skin + extra);
+        pairs_.build(particles_, ownedCount());
+        decomposition_->restoreHistory(particles_, pairs_, wallContacts_);
+    } else {
+        pairs_.build(particles_);
+    }
     if (liquidNetwork_) redistributeLiquid(extra);
     rebuildWallCandidates();
 }
@@ -341,14 +398,20 @@ void Simulation::step(long steps) {
             computeForces();
             forcesValid_ = true;
         }
-        kickAndDrift(particles_, dt);
+        kickAndDrift(particles_, dt, ownedCount());
         ++step_;
         // Time from the step count: no drift from summing dt, exact on restart.
         time_ = step_ * dt;
         removeLostParticles();
-        if (last_.lostThisStep > 0 || pairs_.needsRebuild(particles_)) updatePairList();
+        bool rebuild = last_.lostThisStep > 0 || pairs_.needsRebuild(particles_);
+        if (decomposition_) {
+            // All ranks rebuild together (the rebuild exchanges particles).
+            rebuild = decomposition_->communicator().anyTrue(rebuild);
+            if (!rebuild) decomposition_->updateGhosts(particles_);
+        }
+        if (rebuild) updatePairList();
         computeForces();
-        kick(particles_, dt);
+        kick(particles_, dt, ownedCount());
     }
 }
 

@@ -17,6 +17,7 @@ constexpr const char* restartFormat = "diefill-demLib-restart-1";
 }
 
 void Simulation::writeRestart(const std::string& path) const {
+    requireNoDecomposition("writeRestart");
     const std::string tmp = path + ".writing";
     {
         Hdf5File f(tmp, Hdf5File::Mode::Create);
@@ -102,6 +103,7 @@ void Simulation::writeRestart(const std::string& path) const {
 }
 
 void Simulation::readRestart(const std::string& path) {
+    requireNoDecomposition("readRestart");
     Hdf5File f(path, Hdf5File::Mode::Read);
     const std::string format = f.stringAttribute("format");
     if (format != restartFormat)

@@ -6,10 +6,11 @@
 
 namespace dem {
 
-// v += dt/2 F/m, ω += dt/2 T/I, then x += dt v.
-void kickAndDrift(ParticleStore& particles, double dt);
+// v += dt/2 F/m, ω += dt/2 T/I, then x += dt v, for particles 0 .. count-1
+// (default: all; with MPI ghosts stored after them, the owned ones).
+void kickAndDrift(ParticleStore& particles, double dt, std::size_t count = static_cast<std::size_t>(-1));
 
-// v += dt/2 F/m, ω += dt/2 T/I.
-void kick(ParticleStore& particles, double dt);
+// v += dt/2 F/m, ω += dt/2 T/I, for particles 0 .. count-1.
+void kick(ParticleStore& particles, double dt, std::size_t count = static_cast<std::size_t>(-1));
 
 }  // namespace dem

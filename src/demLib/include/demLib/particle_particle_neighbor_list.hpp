@@ -29,7 +29,11 @@ public:
 
     // Rebuilds the list from the current positions; pair state of pairs that
     // stay neighbours is kept.  Deterministic for any thread count.
-    void build(const ParticleStore& particles);
+    // listedRows: only particles 0 .. listedRows-1 are first particles of
+    // pairs (default: all).  With MPI ghosts stored after the owned particles,
+    // listedRows = owned count: ghosts are partners only, ghost-ghost pairs
+    // are not listed.
+    void build(const ParticleStore& particles, std::size_t listedRows = static_cast<std::size_t>(-1));
 
     // Particles were reordered or removed: oldToNew[i] is the new index of old
     // particle i, or -1.  Keeps the pair state of surviving pairs.
@@ -54,7 +58,8 @@ public:
     std::size_t bytes() const;
 
 private:
-    void buildFrom(const ParticleStore& particles, const std::vector<Vec3>& positions);
+    void buildFrom(const ParticleStore& particles, const std::vector<Vec3>& positions,
+                   std::size_t listedRows = static_cast<std::size_t>(-1));
 
     double skin_ = 0.0;
     double extraRange_ = 0.0;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "demLib/contact_force_kernel.hpp"
+#include "demLib/ghost_exchange.hpp"
 #include "demLib/insertion.hpp"
 #include "demLib/interaction_properties.hpp"
 #include "demLib/liquid_bridges.hpp"
@@ -88,6 +89,21 @@ public:
 
     void step(long steps = 1);
 
+    // MPI domain decomposition (docs/engine.md, "Domain decomposition"): from
+    // now on this rank owns the particles in its slab and holds ghosts of its
+    // neighbours' particles after them.  Set before any particle is inserted;
+    // every rank then calls insert() with the same particles (ids are given
+    // the same on all ranks, each keeps those it owns) and step() the same
+    // number of times.  Not available with capillary cohesion or restart
+    // files yet (InputError).
+    void setDecomposition(std::shared_ptr<GhostExchange> decomposition);
+    const GhostExchange* decomposition() const { return decomposition_.get(); }
+    // Particles integrated by this rank: all of them without a decomposition,
+    // else the owned ones, stored first (particles().size() - ghosts).
+    std::size_t ownedCount() const {
+        return decomposition_ ? decomposition_->ownedCount(particles_) : particles_.size();
+    }
+
     double time() const { return time_; }
     long stepCount() const { return step_; }
     double timeStep() const { return settings_.timeStep; }
@@ -139,6 +155,7 @@ private:
     void wallBridgeCandidates(double reach, std::vector<WallContactRecord>& records,
                               std::vector<double>& gaps) const;
     void computeForces();
+    void requireNoDecomposition(const std::string& what) const;
 
     SimulationSettings settings_;
     std::vector<Material> materials_;
@@ -159,6 +176,7 @@ private:
     std::unique_ptr<LiquidBridgeNetwork> liquidNetwork_;
     double largestBridge_ = 0.0;
     StepStatistics last_;
+    std::shared_ptr<GhostExchange> decomposition_;  // null: serial run
 };
 
 }  // namespace dem

@@ -1,0 +1,363 @@
+#include "demLib/ghost_exchange.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <limits>
+#include <string>
+
+#include "demLib/error.hpp"
+
+namespace dem {
+
+namespace {
+
+// Byte buffers of plain values (same executable on every rank: no byte-order
+// or layout conversion).
+struct ByteWriter {
+    std::vector<char>& out;
+    template <class T>
+    void put(const T& v) {
+        const std::size_t at = out.size();
+        out.resize(at + sizeof(T));
+        std::memcpy(out.data() + at, &v, sizeof(T));
+    }
+    void put(const Vec3& v) {
+        put(v.x());
+        put(v.y());
+        put(v.z());
+    }
+};
+
+struct ByteReader {
+    const std::vector<char>& in;
+    std::size_t at = 0;
+    template <class T>
+    T get() {
+        if (at + sizeof(T) > in.size()) throw RuntimeError("demLib ghost exchange: truncated message");
+        T v;
+        std::memcpy(&v, in.data() + at, sizeof(T));
+        at += sizeof(T);
+        return v;
+    }
+    Vec3 vec() {
+        const double x = get<double>(), y = get<double>(), z = get<double>();
+        return Vec3(x, y, z);
+    }
+    bool done() const { return at == in.size(); }
+};
+
+// Every ParticleStore field, in one place: a field added to the store must be
+// added here too, or migrating particles would lose it.
+void packParticle(ByteWriter& w, const ParticleStore& p, std::size_t i) {
+    w.put(p.id[i]);
+    w.put(p.position[i]);
+    w.put(p.velocity[i]);
+    w.put(p.omega[i]);
+    w.put(p.force[i]);
+    w.put(p.torque[i]);
+    w.put(p.radius[i]);
+    w.put(p.mass[i]);
+    w.put(p.invMass[i]);
+    w.put(p.invInertia[i]);
+    w.put(p.material[i]);
+    w.put(p.externalForce[i]);
+}
+
+void unpackParticle(ByteReader& r, ParticleStore& p) {
+    p.id.push_back(r.get<std::int64_t>());
+    p.position.push_back(r.vec());
+    p.velocity.push_back(r.vec());
+    p.omega.push_back(r.vec());
+    p.force.push_back(r.vec());
+    p.torque.push_back(r.vec());
+    p.radius.push_back(r.get<double>());
+    p.mass.push_back(r.get<double>());
+    p.invMass.push_back(r.get<double>());
+    p.invInertia.push_back(r.get<double>());
+    p.material.push_back(r.get<int>());
+    p.externalForce.push_back(r.vec());
+}
+
+void packHistory(ByteWriter& w, const ContactHistory& h) {
+    w.put(h.shear);
+    w.put(h.rollingTorque);
+}
+
+ContactHistory unpackHistory(ByteReader& r) {
+    ContactHistory h;
+    h.shear = r.vec();
+    h.rollingTorque = r.vec();
+    return h;
+}
+
+bool isBlank(const ContactHistory& h) { return h.shear.isZero(0.0) && h.rollingTorque.isZero(0.0); }
+
+// History vectors are defined for the first particle of a pair: seen from the
+// other one they change sign (as in ParticleParticleNeighborList::remap).
+PairState seenFromOther(PairState s) {
+    s.contact.shear = -s.contact.shear;
+    s.contact.rollingTorque = -s.contact.rollingTorque;
+    return s;
+}
+
+bool pairKeyLess(const GhostExchange::PairRecord& a, const GhostExchange::PairRecord& b) {
+    return a.first != b.first ? a.first < b.first : a.second < b.second;
+}
+
+bool wallKeyLess(const GhostExchange::WallRecord& a, const GhostExchange::WallRecord& b) {
+    if (a.particle != b.particle) return a.particle < b.particle;
+    if (a.wall != b.wall) return a.wall < b.wall;
+    return a.feature < b.feature;
+}
+
+}  // namespace
+
+GhostExchange::GhostExchange(Communicator communicator, SlabDecomposition slabs)
+    : communicator_(std::move(communicator)), slabs_(std::move(slabs)) {
+    if (slabs_.ranks() != communicator_.size())
+        throw InputError("demLib domain decomposition: " + std::to_string(slabs_.ranks()) + " slabs for " +
+                         std::to_string(communicator_.size()) + " ranks; expected one slab per rank");
+    sendList_.assign(communicator_.size(), {});
+    receiveCount_.assign(communicator_.size(), 0);
+}
+
+void GhostExchange::dropGhosts(ParticleStore& p, ParticleParticleNeighborList& pairs, ParticleWallContacts& walls) {
+    const std::size_t owned = ownedCount(p);
+    const auto& offsets = pairs.offsets();
+    const auto& neighbors = pairs.neighbors();
+    const auto& state = pairs.state();
+    const std::size_t rows = offsets.size() - 1;
+    for (std::size_t i = 0; i < rows; ++i) {
+        for (int k = offsets[i]; k < offsets[i + 1]; ++k) {
+            const PairState& s = state[k];
+            if (isBlank(s.contact) && s.bridgeVolume == 0.0) continue;  // nothing to remember
+            const std::int64_t a = p.id[i], b = p.id[neighbors[k]];
+            if (a < b)
+                pairStash_.push_back({a, b, s});
+            else
+                pairStash_.push_back({b, a, seenFromOther(s)});
+        }
+    }
+    for (const WallContactRecord& r : walls.records()) {
+        if (static_cast<std::size_t>(r.particle) >= owned) continue;  // a ghost's copy: its owner has the original
+        if (isBlank(r.history) && r.bridgeVolume == 0.0) continue;
+        wallStash_.push_back({p.id[r.particle], r.wall, r.feature, r.history, r.bridgeVolume});
+    }
+    walls.records().clear();
+    pairs.remap(std::vector<int>(rows, -1));  // empties the list (and its build positions)
+    if (ghostCount_ > 0) {
+        std::vector<char> keep(p.size(), 0);
+        std::fill(keep.begin(), keep.begin() + owned, 1);
+        p.compact(keep);
+        ghostCount_ = 0;
+    }
+    for (auto& list : sendList_) list.clear();
+    std::fill(receiveCount_.begin(), receiveCount_.end(), 0);
+}
+
+std::size_t GhostExchange::migrate(ParticleStore& p) {
+    if (ghostCount_ != 0) throw RuntimeError("demLib ghost exchange: migrate() called with ghosts present");
+    const int ranks = communicator_.size();
+    const int me = rank();
+    const std::size_t n = p.size();
+    std::vector<int> destination(n, me);
+    std::vector<std::vector<std::size_t>> leaving(ranks);
+    std::vector<std::pair<std::int64_t, int>> leavingIds;  // (id, destination), sorted by id
+    std::size_t left = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        destination[i] = slabs_.ownerOf(p.position[i], me);
+        if (destination[i] == me) continue;
+        leaving[destination[i]].push_back(i);
+        leavingIds.emplace_back(p.id[i], destination[i]);
+        ++left;
+    }
+    // Every rank takes part, even with nothing to send.
+    std::sort(leavingIds.begin(), leavingIds.end());
+    auto destinationOfId = [&](std::int64_t id) {
+        const auto it = std::lower_bound(leavingIds.begin(), leavingIds.end(), std::make_pair(id, -1));
+        return it != leavingIds.end() && it->first == id ? it->second : me;
+    };
+    // Per destination: the particles, then the stashed history involving them
+    // (a copy: this rank may still compute the pair with a ghost).
+    std::vector<std::vector<PairRecord>> pairsTo(ranks);
+    for (const PairRecord& rec : pairStash_) {
+        const int da = destinationOfId(rec.first), db = destinationOfId(rec.second);
+        if (da != me) pairsTo[da].push_back(rec);
+        if (db != me && db != da) pairsTo[db].push_back(rec);
+    }
+    std::vector<std::vector<WallRecord>> wallsTo(ranks);
+    for (const WallRecord& rec : wallStash_) {
+        const int d = destinationOfId(rec.particle);
+        if (d != me) wallsTo[d].push_back(rec);
+    }
+    std::vector<std::vector<char>> send(ranks);
+    for (int r = 0; r < ranks; ++r) {
+        if (r == me || (leaving[r].empty() && pairsTo[r].empty() && wallsTo[r].empty())) continue;
+        ByteWriter w{send[r]};
+        w.put(static_cast<std::uint64_t>(leaving[r].size()));
+        for (std::size_t i : leaving[r]) packParticle(w, p, i);
+        w.put(static_cast<std::uint64_t>(pairsTo[r].size()));
+        for (const PairRecord& rec : pairsTo[r]) {
+            w.put(rec.first);
+            w.put(rec.second);
+            packHistory(w, rec.state.contact);
+            w.put(rec.state.bridgeVolume);
+        }
+        w.put(static_cast<std::uint64_t>(wallsTo[r].size()));
+        for (const WallRecord& rec : wallsTo[r]) {
+            w.put(rec.particle);
+            w.put(rec.wall);
+            w.put(rec.feature);
+            packHistory(w, rec.history);
+            w.put(rec.bridgeVolume);
+        }
+    }
+    const std::vector<std::vector<char>> received = communicator_.exchange(send);
+    if (left > 0) {
+        std::vector<char> keep(n);
+        for (std::size_t i = 0; i < n; ++i) keep[i] = destination[i] == me;
+        p.compact(keep);
+    }
+    // Received in rank order after this rank's own entries: restoreHistory
+    // keeps the first record of a key, so a rank's own copy of a pair wins.
+    for (int r = 0; r < ranks; ++r) {
+        if (r == me || received[r].empty()) continue;
+        ByteReader in{received[r]};
+        const auto particles = in.get<std::uint64_t>();
+        for (std::uint64_t k = 0; k < particles; ++k) unpackParticle(in, p);
+        const auto pairRecords = in.get<std::uint64_t>();
+        for (std::uint64_t k = 0; k < pairRecords; ++k) {
+            PairRecord rec;
+            rec.first = in.get<std::int64_t>();
+            rec.second = in.get<std::int64_t>();
+            rec.state.contact = unpackHistory(in);
+            rec.state.bridgeVolume = in.get<double>();
+            pairStash_.push_back(rec);
+        }
+        const auto wallRecords = in.get<std::uint64_t>();
+        for (std::uint64_t k = 0; k < wallRecords; ++k) {
+            WallRecord rec;
+            rec.particle = in.get<std::int64_t>();
+            rec.wall = in.get<int>();
+            rec.feature = in.get<int>();
+            rec.history = unpackHistory(in);
+            rec.bridgeVolume = in.get<double>();
+            wallStash_.push_back(rec);
+        }
+        if (!in.done()) throw RuntimeError("demLib ghost exchange: malformed migration message");
+    }
+    migrated_ += left;
+    return left;
+}
+
+void GhostExchange::appendGhosts(ParticleStore& p, double haloWidth) {
+    if (ghostCount_ != 0) throw RuntimeError("demLib ghost exchange: appendGhosts() called with ghosts present");
+    const int ranks = communicator_.size();
+    const int me = rank();
+    const std::size_t owned = p.size();
+    // A pair closer than haloWidth has both centres within haloWidth of the
+    // other's slab; the margin only adds ghosts, never removes needed ones.
+    const double reach = haloWidth * (1.0 + 1e-9);
+    std::vector<std::vector<char>> send(ranks);
+    for (int r = 0; r < ranks; ++r) {
+        sendList_[r].clear();
+        if (r == me) continue;
+        for (std::size_t i = 0; i < owned; ++i)
+            if (slabs_.distanceToSlab(r, p.position[i]) < reach) sendList_[r].push_back(static_cast<int>(i));
+        ByteWriter w{send[r]};
+        for (int i : sendList_[r]) packParticle(w, p, static_cast<std::size_t>(i));
+    }
+    const std::vector<std::vector<char>> received = communicator_.exchange(send);
+    for (int r = 0; r < ranks; ++r) {
+        receiveCount_[r] = 0;
+        if (r == me) continue;
+        ByteReader in{received[r]};
+        while (!in.done()) {
+            unpackParticle(in, p);
+            ++receiveCount_[r];
+        }
+    }
+    ghostCount_ = p.size() - owned;
+}
+
+void GhostExchange::updateGhosts(ParticleStore& p) const {
+    const int ranks = communicator_.size();
+    const int me = rank();
+    std::vector<std::vector<char>> send(ranks);
+    for (int r = 0; r < ranks; ++r) {
+        if (r == me || sendList_[r].empty()) continue;
+        ByteWriter w{send[r]};
+        for (int i : sendList_[r]) {
+            w.put(p.position[i]);
+            w.put(p.velocity[i]);
+            w.put(p.omega[i]);
+        }
+    }
+    const std::vector<std::vector<char>> received = communicator_.exchange(send);
+    std::size_t g = ownedCount(p);
+    for (int r = 0; r < ranks; ++r) {
+        if (r == me) continue;
+        ByteReader in{received[r]};
+        for (std::size_t k = 0; k < receiveCount_[r]; ++k, ++g) {
+            p.position[g] = in.vec();
+            p.velocity[g] = in.vec();
+            p.omega[g] = in.vec();
+        }
+        if (!in.done())
+            throw RuntimeError("demLib ghost exchange: rank " + std::to_string(r) +
+                               " sent a ghost update of the wrong size");
+    }
+}
+
+void GhostExchange::restoreHistory(const ParticleStore& p, ParticleParticleNeighborList& pairs,
+                                   ParticleWallContacts& walls) {
+    // Stable: of two records of one key the first (this rank's own) is kept.
+    std::stable_sort(pairStash_.begin(), pairStash_.end(), pairKeyLess);
+    pairStash_.erase(std::unique(pairStash_.begin(), pairStash_.end(),
+                                 [](const PairRecord& a, const PairRecord& b) {
+                                     return a.first == b.first && a.second == b.second;
+                                 }),
+                     pairStash_.end());
+    const auto& offsets = pairs.offsets();
+    const auto& neighbors = pairs.neighbors();
+    auto& state = pairs.state();
+    if (!pairStash_.empty()) {
+        for (std::size_t i = 0; i + 1 < offsets.size(); ++i) {
+            for (int k = offsets[i]; k < offsets[i + 1]; ++k) {
+                const std::int64_t a = p.id[i], b = p.id[neighbors[k]];
+                const PairRecord key{std::min(a, b), std::max(a, b), PairState{}};
+                const auto it = std::lower_bound(pairStash_.begin(), pairStash_.end(), key, pairKeyLess);
+                if (it == pairStash_.end() || it->first != key.first || it->second != key.second) continue;
+                state[k] = a < b ? it->state : seenFromOther(it->state);
+            }
+        }
+    }
+    std::stable_sort(wallStash_.begin(), wallStash_.end(), wallKeyLess);
+    wallStash_.erase(std::unique(wallStash_.begin(), wallStash_.end(),
+                                 [](const WallRecord& a, const WallRecord& b) {
+                                     return a.particle == b.particle && a.wall == b.wall && a.feature == b.feature;
+                                 }),
+                     wallStash_.end());
+    auto& records = walls.records();
+    records.clear();
+    if (!wallStash_.empty()) {
+        const std::size_t owned = ownedCount(p);
+        for (std::size_t i = 0; i < owned; ++i) {
+            WallRecord key{p.id[i], std::numeric_limits<int>::min(), std::numeric_limits<int>::min(), ContactHistory{}, 0.0};
+            auto it = std::lower_bound(wallStash_.begin(), wallStash_.end(), key, wallKeyLess);
+            for (; it != wallStash_.end() && it->particle == p.id[i]; ++it) {
+                WallContactRecord rec;
+                rec.particle = static_cast<int>(i);
+                rec.wall = it->wall;
+                rec.feature = it->feature;
+                rec.history = it->history;
+                rec.bridgeVolume = it->bridgeVolume;
+                records.push_back(rec);  // particle, then (wall, feature) order: sorted
+            }
+        }
+    }
+    pairStash_.clear();
+    wallStash_.clear();
+}
+
+}  // namespace dem
