@@ -31,6 +31,12 @@ public:
                               ParticleWallContacts& wallContacts, const std::vector<Wall>& walls,
                               const ParticleWallCandidates& wallCandidates,
                               const InteractionTable& interactions, double time, double dt) override {
+        // The list must keep the pair-state parts this law uses (the owner
+        // normally configured it so; this only adds missing ones).
+        const PairStateFields need = PairStateFields::forModels(Rolling, Cohesion == CohesionModel::Capillary);
+        const PairStateFields have = pairs.stateFields();
+        if ((need.rollingTorque && !have.rollingTorque) || (need.bridgeVolume && !have.bridgeVolume))
+            pairs.setStateFields({have.rollingTorque || need.rollingTorque, have.bridgeVolume || need.bridgeVolume});
         const int n = static_cast<int>(p.size());
         const int threads = threadsFor(n, heavyLoopParticlesPerThread);
         // Thread 0 accumulates into the particle arrays; the others into their own
@@ -42,6 +48,8 @@ public:
             buffers_[t].torque.assign(n, Vec3::Zero());
         }
         std::vector<ContactStatistics> stats(threads);
+        changes_.resize(threads);
+        for (auto& c : changes_) c.clear();
         std::vector<std::vector<WallContactRecord>> newWall(threads);
 
 #pragma omp parallel num_threads(threads)
@@ -51,10 +59,12 @@ public:
             Vec3* torque = t == 0 ? p.torque.data() : buffers_[t].torque.data();
             const int begin = static_cast<int>(static_cast<long>(n) * t / threads);
             const int end = static_cast<int>(static_cast<long>(n) * (t + 1) / threads);
-            pairForces(p, pairs, interactions, dt, begin, end, force, torque, stats[t]);
+            pairForces(p, pairs, interactions, dt, begin, end, force, torque, stats[t], changes_[t]);
             wallForces(p, wallContacts, walls, wallCandidates, interactions, time, dt, begin, end, force,
                        torque, newWall[t], stats[t]);
         }
+
+        pairs.history().commit(changes_);
 
         ContactStatistics total;
         std::size_t wallCount = 0;
@@ -86,13 +96,27 @@ private:
         std::vector<Vec3> torque;
     };
     std::vector<Buffer> buffers_;
+    std::vector<ContactHistoryPool::Changes> changes_;  // per thread, reused
 
     void pairForces(ParticleStore& p, ParticleParticleNeighborList& pairs,
                     const InteractionTable& interactions, double dt, int begin, int end, Vec3* force,
-                    Vec3* torque, ContactStatistics& stats) const {
-        const auto& offsets = pairs.offsets();
-        const auto& neighbors = pairs.neighbors();
-        auto& state = pairs.state();
+                    Vec3* torque, ContactStatistics& stats, ContactHistoryPool::Changes& changes) const {
+        constexpr bool keepsRolling = Rolling == RollingModel::EPSD || Rolling == RollingModel::EPSD2;
+        const int* offsets = pairs.offsets().data();
+        const int* neighbors = pairs.neighbors().data();
+        ContactHistoryPool& pool = pairs.history();
+        int* slot = pool.slots();
+        double* records = pool.record(0);  // slots are only handed out after the loop
+        const std::size_t stride = pool.stride();
+        double* bridge = Cohesion == CohesionModel::Capillary ? pairs.bridgeVolume().data() : nullptr;
+        // A contact that opens forgets its springs (LIGGGHTS surfacesClose):
+        // its history slot goes back to the pool.
+        auto forget = [&](int k) {
+            if (slot[k] >= 0) {
+                changes.released.push_back(slot[k]);
+                slot[k] = -1;
+            }
+        };
         for (int i = begin; i < end; ++i) {
             const Vec3 xi = p.position[i];
             const double ri = p.radius[i];
@@ -100,14 +124,13 @@ private:
             Vec3 ti = Vec3::Zero();
             for (int k = offsets[i]; k < offsets[i + 1]; ++k) {
                 const int j = neighbors[k];
-                PairState& s = state[k];
                 const Vec3 d = xi - p.position[j];
                 const double rj = p.radius[j];
                 const double radiusSum = ri + rj;
                 const double dist2 = d.squaredNorm();
                 if constexpr (Cohesion == CohesionModel::None) {
                     if (dist2 >= radiusSum * radiusSum) {
-                        s.contact = ContactHistory{};
+                        forget(k);
                         continue;
                     }
                 }
@@ -117,19 +140,20 @@ private:
 
                 double cohesiveForce = 0.0;
                 if constexpr (Cohesion == CohesionModel::Capillary) {
-                    if (s.bridgeVolume > 0.0) {
+                    double& volume = bridge[k];
+                    if (volume > 0.0) {
                         const double gap = -overlap;
-                        if (gap > debondingDistance(s.bridgeVolume, settings_.capillary.contactAngle)) {
-                            stats.releasedLiquid += s.bridgeVolume;  // back to the free liquid
-                            s.bridgeVolume = 0.0;
+                        if (gap > debondingDistance(volume, settings_.capillary.contactAngle)) {
+                            stats.releasedLiquid += volume;  // back to the free liquid
+                            volume = 0.0;
                         } else {
                             cohesiveForce = settings_.capillaryForceScale *
-                                            capillaryForce(ri, rj, gap, s.bridgeVolume, settings_.capillary);
+                                            capillaryForce(ri, rj, gap, volume, settings_.capillary);
                             ++stats.bridges;
                         }
                     }
                     if (overlap <= 0.0) {
-                        s.contact = ContactHistory{};
+                        forget(k);
                         if (cohesiveForce != 0.0) {
                             const Vec3 f = cohesiveForce * normal;
                             fi += f;
@@ -152,8 +176,23 @@ private:
                 kin.dt = dt;
                 if constexpr (Rolling == RollingModel::EPSD)
                     kin.rollingInertiaEff = rollingInertiaEff(p.mass[i], ri, p.mass[j], rj);
+                // A contact without a slot is new: its springs start from zero
+                // and get a slot after the loop.
+                const int s = slot[k];
+                ContactHistory history;
+                double* record = s >= 0 ? records + s * stride : nullptr;
+                if (record) {
+                    history.shear = Vec3::Map(record);
+                    if constexpr (keepsRolling) history.rollingTorque = Vec3::Map(record + 3);
+                }
                 const ContactForces f =
-                    Law::evaluate(kin, interactions(p.material[i], p.material[j]), s.contact, cohesiveForce);
+                    Law::evaluate(kin, interactions(p.material[i], p.material[j]), history, cohesiveForce);
+                if (record) {
+                    Vec3::Map(record) = history.shear;
+                    if constexpr (keepsRolling) Vec3::Map(record + 3) = history.rollingTorque;
+                } else {
+                    changes.opened.push_back({k, history});
+                }
                 fi += f.force;
                 force[j] -= f.force;
                 const Vec3 nxFt = normal.cross(f.tangentialForce);

@@ -57,10 +57,8 @@ void packParticle(ByteWriter& w, const ParticleStore& p, std::size_t i) {
     w.put(p.torque[i]);
     w.put(p.radius[i]);
     w.put(p.mass[i]);
-    w.put(p.invMass[i]);
-    w.put(p.invInertia[i]);
     w.put(p.material[i]);
-    w.put(p.externalForce[i]);
+    w.put(p.externalForce[i]);  // const: reading does not allocate
 }
 
 void unpackParticle(ByteReader& r, ParticleStore& p) {
@@ -72,8 +70,6 @@ void unpackParticle(ByteReader& r, ParticleStore& p) {
     p.torque.push_back(r.vec());
     p.radius.push_back(r.get<double>());
     p.mass.push_back(r.get<double>());
-    p.invMass.push_back(r.get<double>());
-    p.invInertia.push_back(r.get<double>());
     p.material.push_back(r.get<int>());
     p.externalForce.push_back(r.vec());
 }
@@ -125,11 +121,11 @@ void GhostExchange::dropGhosts(ParticleStore& p, ParticleParticleNeighborList& p
     const std::size_t owned = ownedCount(p);
     const auto& offsets = pairs.offsets();
     const auto& neighbors = pairs.neighbors();
-    const auto& state = pairs.state();
+    const PairStateView state = pairs.state();
     const std::size_t rows = offsets.size() - 1;
     for (std::size_t i = 0; i < rows; ++i) {
         for (int k = offsets[i]; k < offsets[i + 1]; ++k) {
-            const PairState& s = state[k];
+            const PairState s = state[k];
             if (isBlank(s.contact) && s.bridgeVolume == 0.0) continue;  // nothing to remember
             const std::int64_t a = p.id[i], b = p.id[neighbors[k]];
             if (a < b)
@@ -320,7 +316,6 @@ void GhostExchange::restoreHistory(const ParticleStore& p, ParticleParticleNeigh
                      pairStash_.end());
     const auto& offsets = pairs.offsets();
     const auto& neighbors = pairs.neighbors();
-    auto& state = pairs.state();
     if (!pairStash_.empty()) {
         for (std::size_t i = 0; i + 1 < offsets.size(); ++i) {
             for (int k = offsets[i]; k < offsets[i + 1]; ++k) {
@@ -328,7 +323,7 @@ void GhostExchange::restoreHistory(const ParticleStore& p, ParticleParticleNeigh
                 const PairRecord key{std::min(a, b), std::max(a, b), PairState{}};
                 const auto it = std::lower_bound(pairStash_.begin(), pairStash_.end(), key, pairKeyLess);
                 if (it == pairStash_.end() || it->first != key.first || it->second != key.second) continue;
-                state[k] = a < b ? it->state : seenFromOther(it->state);
+                pairs.setStateAt(static_cast<std::size_t>(k), a < b ? it->state : seenFromOther(it->state));
             }
         }
     }

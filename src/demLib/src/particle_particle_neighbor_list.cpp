@@ -15,7 +15,39 @@ namespace dem {
 
 namespace {
 
+// For each entry of the new list, the entry of the old list holding the same
+// pair (-1: new pair).  Both lists are sorted by j within each i: a merge.
+std::vector<int> matchOldEntries(const std::vector<int>& oldOffsets, const std::vector<int>& oldNeighbors,
+                                 const std::vector<int>& offsets, const std::vector<int>& neighbors,
+                                 bool canTransfer) {
+    std::vector<int> from(neighbors.size(), -1);
+    if (!canTransfer) return from;
+    const int oldN = static_cast<int>(oldOffsets.size()) - 1;
+#pragma omp parallel for schedule(static) num_threads(threadsFor(oldN, lightLoopParticlesPerThread))
+    for (int i = 0; i < oldN; ++i) {
+        int a = oldOffsets[i];
+        const int aEnd = oldOffsets[i + 1];
+        for (int b = offsets[i]; b < offsets[i + 1] && a < aEnd; ++b) {
+            while (a < aEnd && oldNeighbors[a] < neighbors[b]) ++a;
+            if (a < aEnd && oldNeighbors[a] == neighbors[b]) from[b] = a;
+        }
+    }
+    return from;
+}
+
 }  // namespace
+
+void ParticleParticleNeighborList::setStateFields(const PairStateFields& fields) {
+    if (fields == fields_) return;
+    history_.setRolling(fields.rollingTorque);
+    if (fields.bridgeVolume != fields_.bridgeVolume) {
+        if (fields.bridgeVolume)
+            bridgeVolume_.assign(neighbors_.size(), 0.0);
+        else
+            std::vector<double>().swap(bridgeVolume_);
+    }
+    fields_ = fields;
+}
 
 void ParticleParticleNeighborList::setRanges(double skin, double extraRange) {
     skin_ = skin;
@@ -44,7 +76,8 @@ void ParticleParticleNeighborList::restore(const ParticleStore& particles,
                                            long buildCount) {
     offsets_.assign(1, 0);
     neighbors_.clear();
-    state_.clear();
+    history_.reset(0);
+    bridgeVolume_.clear();
     buildFrom(particles, positionAtBuild);
     positionAtBuild_ = positionAtBuild;
     buildCount_ = buildCount;
@@ -56,8 +89,15 @@ bool ParticleParticleNeighborList::setState(int i, int j, const PairState& s) {
     const auto last = neighbors_.begin() + offsets_[i + 1];
     const auto it = std::lower_bound(first, last, j);
     if (it == last || *it != j) return false;
-    state_[it - neighbors_.begin()] = s;
+    setStateAt(static_cast<std::size_t>(it - neighbors_.begin()), s);
     return true;
+}
+
+void ParticleParticleNeighborList::setStateAt(std::size_t k, const PairState& s) {
+    // Zero history is what "no slot" means already.
+    if (!s.contact.shear.isZero(0.0) || (fields_.rollingTorque && !s.contact.rollingTorque.isZero(0.0)))
+        history_.set(k, s.contact);
+    if (fields_.bridgeVolume) bridgeVolume_[k] = s.bridgeVolume;
 }
 
 void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
@@ -67,16 +107,18 @@ void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
     const int rows = static_cast<int>(std::min(listedRows, particles.size()));
     std::vector<int> oldOffsets;
     std::vector<int> oldNeighbors;
-    std::vector<PairState> oldState;
     oldOffsets.swap(offsets_);
     oldNeighbors.swap(neighbors_);
-    oldState.swap(state_);
     // Particles appended since the last build (insertion) have no old pairs.
     const int oldN = static_cast<int>(oldOffsets.size()) - 1;
     const bool canTransfer = oldN >= 0 && oldN <= n;
 
     offsets_.assign(n + 1, 0);
-    if (n == 0) return;
+    if (n == 0) {
+        history_.reset(0);
+        bridgeVolume_.clear();
+        return;
+    }
 
     // Cells at least one interaction range wide, so that only the 27
     // surrounding cells need a look.
@@ -137,59 +179,87 @@ void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
         }
     }
     for (int i = 0; i < n; ++i) offsets_[i + 1] = offsets_[i] + count[i];
-    neighbors_.reserve(offsets_[n]);
-    for (const auto& block : blockNeighbors) neighbors_.insert(neighbors_.end(), block.begin(), block.end());
-    state_.assign(neighbors_.size(), PairState{});
-
-    if (!canTransfer) return;
-    // Both lists are sorted by j within each i: merge to carry the pair state over.
-#pragma omp parallel for schedule(static) num_threads(threadsFor(oldN, lightLoopParticlesPerThread))
-    for (int i = 0; i < oldN; ++i) {
-        int a = oldOffsets[i];
-        const int aEnd = oldOffsets[i + 1];
-        for (int b = offsets_[i]; b < offsets_[i + 1] && a < aEnd; ++b) {
-            while (a < aEnd && oldNeighbors[a] < neighbors_[b]) ++a;
-            if (a < aEnd && oldNeighbors[a] == neighbors_[b]) state_[b] = oldState[a];
+    std::vector<int>().swap(count);
+    if (threads == 1) {
+        neighbors_.swap(blockNeighbors[0]);
+        neighbors_.shrink_to_fit();
+    } else {
+        neighbors_.reserve(offsets_[n]);
+        for (auto& block : blockNeighbors) {
+            neighbors_.insert(neighbors_.end(), block.begin(), block.end());
+            std::vector<int>().swap(block);
         }
     }
+
+    const std::vector<int> from = matchOldEntries(oldOffsets, oldNeighbors, offsets_, neighbors_, canTransfer);
+    std::vector<int>().swap(oldOffsets);
+    std::vector<int>().swap(oldNeighbors);
+    if (fields_.bridgeVolume) {
+        std::vector<double> bridge(neighbors_.size(), 0.0);
+        if (canTransfer)
+            for (std::size_t b = 0; b < from.size(); ++b)
+                if (from[b] >= 0) bridge[b] = bridgeVolume_[from[b]];
+        bridgeVolume_.swap(bridge);
+    }
+    // Pairs in contact now get their history slot here, in list order; only
+    // contacts that close later take slots out of order.
+    std::vector<char> touching(neighbors_.size(), 0);
+#pragma omp parallel for schedule(static) num_threads(threadsFor(n, lightLoopParticlesPerThread))
+    for (int i = 0; i < n; ++i)
+        for (int k = offsets_[i]; k < offsets_[i + 1]; ++k) {
+            const int j = neighbors_[k];
+            const double contact = particles.radius[i] + particles.radius[j];
+            touching[k] = (positions[j] - positions[i]).squaredNorm() < contact * contact;
+        }
+    if (!canTransfer) history_.reset(0);
+    history_.rebuild(from, {}, touching);
 }
 
 void ParticleParticleNeighborList::remap(const std::vector<int>& oldToNew) {
     const int oldN = static_cast<int>(offsets_.size()) - 1;
     int newN = 0;
     for (int k : oldToNew) newN = std::max(newN, k + 1);
+    // The surviving pairs as (new i, new j, old entry); `flip` when the pair is
+    // seen from the other particle now.
     struct Entry {
-        int i, j;
-        PairState s;
+        int i, j, from;
+        bool flip;
     };
     std::vector<Entry> entries;
+    entries.reserve(neighbors_.size());
     for (int i = 0; i < oldN; ++i) {
         for (int k = offsets_[i]; k < offsets_[i + 1]; ++k) {
             const int a = oldToNew[i], b = oldToNew[neighbors_[k]];
             if (a < 0 || b < 0) continue;
-            PairState s = state_[k];
-            if (a < b) {
-                entries.push_back({a, b, s});
-            } else {
-                // The pair is seen from the other particle now: history vectors,
-                // defined for the first particle of the pair, change sign.
-                s.contact.shear = -s.contact.shear;
-                s.contact.rollingTorque = -s.contact.rollingTorque;
-                entries.push_back({b, a, s});
-            }
+            if (a < b)
+                entries.push_back({a, b, k, false});
+            else
+                entries.push_back({b, a, k, true});
         }
     }
     std::sort(entries.begin(), entries.end(),
               [](const Entry& x, const Entry& y) { return x.i != y.i ? x.i < y.i : x.j < y.j; });
     offsets_.assign(newN + 1, 0);
     neighbors_.resize(entries.size());
-    state_.resize(entries.size());
     for (std::size_t k = 0; k < entries.size(); ++k) {
         ++offsets_[entries[k].i + 1];
         neighbors_[k] = entries[k].j;
-        state_[k] = entries[k].s;
     }
     for (int i = 0; i < newN; ++i) offsets_[i + 1] += offsets_[i];
+    // History vectors are defined for the first particle of the pair: they
+    // change sign when the pair is seen from the other particle.
+    std::vector<int> from(entries.size());
+    std::vector<char> flip(entries.size());
+    for (std::size_t k = 0; k < entries.size(); ++k) {
+        from[k] = entries[k].from;
+        flip[k] = entries[k].flip;
+    }
+    history_.rebuild(from, flip, {});
+    if (fields_.bridgeVolume) {
+        std::vector<double> out(entries.size());
+        for (std::size_t k = 0; k < entries.size(); ++k) out[k] = bridgeVolume_[entries[k].from];
+        bridgeVolume_.swap(out);
+    }
     std::vector<Vec3> moved(newN, Vec3::Zero());
     for (int i = 0; i < oldN && i < static_cast<int>(positionAtBuild_.size()); ++i)
         if (oldToNew[i] >= 0) moved[oldToNew[i]] = positionAtBuild_[i];
@@ -198,7 +268,7 @@ void ParticleParticleNeighborList::remap(const std::vector<int>& oldToNew) {
 
 std::size_t ParticleParticleNeighborList::bytes() const {
     return offsets_.capacity() * sizeof(int) + neighbors_.capacity() * sizeof(int) +
-           state_.capacity() * sizeof(PairState) + positionAtBuild_.capacity() * sizeof(Vec3);
+           history_.bytes() + bridgeVolume_.capacity() * sizeof(double) + positionAtBuild_.capacity() * sizeof(Vec3);
 }
 
 }  // namespace dem

@@ -15,10 +15,9 @@ std::size_t ParticleStore::add(std::int64_t globalId, const Vec3& x, const Vec3&
     torque.push_back(Vec3::Zero());
     radius.push_back(r);
     mass.push_back(m);
-    invMass.push_back(1.0 / m);
-    invInertia.push_back(1.0 / (0.4 * m * r * r));
     material.push_back(materialIndex);
-    externalForce.push_back(Vec3::Zero());
+    ++externalForce.count_;
+    if (externalForce.allocated()) externalForce.values_.push_back(Vec3::Zero());
     return id.size() - 1;
 }
 
@@ -52,10 +51,9 @@ std::vector<int> ParticleStore::compact(const std::vector<char>& keep) {
     keepIf(torque, keep);
     keepIf(radius, keep);
     keepIf(mass, keep);
-    keepIf(invMass, keep);
-    keepIf(invInertia, keep);
     keepIf(material, keep);
-    keepIf(externalForce, keep);
+    if (externalForce.allocated()) keepIf(externalForce.values_, keep);
+    externalForce.count_ = id.size();
     return oldToNew;
 }
 
@@ -68,10 +66,9 @@ void ParticleStore::permute(const std::vector<int>& order) {
     reorder(torque, order);
     reorder(radius, order);
     reorder(mass, order);
-    reorder(invMass, order);
-    reorder(invInertia, order);
     reorder(material, order);
-    reorder(externalForce, order);
+    if (externalForce.allocated()) reorder(externalForce.values_, order);
+    externalForce.count_ = id.size();
 }
 
 void ParticleStore::reserve(std::size_t n) {
@@ -83,10 +80,8 @@ void ParticleStore::reserve(std::size_t n) {
     torque.reserve(n);
     radius.reserve(n);
     mass.reserve(n);
-    invMass.reserve(n);
-    invInertia.reserve(n);
     material.reserve(n);
-    externalForce.reserve(n);
+    if (externalForce.allocated()) externalForce.values_.reserve(n);
 }
 
 double ParticleStore::totalMass() const {
@@ -98,12 +93,25 @@ double ParticleStore::totalMass() const {
 double ParticleStore::kineticEnergy() const {
     double e = 0.0;
     for (std::size_t i = 0; i < size(); ++i)
-        e += 0.5 * mass[i] * velocity[i].squaredNorm() + 0.5 / invInertia[i] * omega[i].squaredNorm();
+        e += 0.5 * mass[i] * velocity[i].squaredNorm() +
+             0.5 / (1.0 / (0.4 * mass[i] * radius[i] * radius[i])) * omega[i].squaredNorm();
     return e;
 }
 
 std::size_t ParticleStore::bytesPerParticle() const {
-    return sizeof(std::int64_t) + 5 * sizeof(Vec3) + 4 * sizeof(double) + sizeof(int);
+    return sizeof(std::int64_t) + 5 * sizeof(Vec3) + 2 * sizeof(double) + sizeof(int) +
+           (externalForce.allocated() ? sizeof(Vec3) : 0);
+}
+
+void ExternalForceField::assign(std::vector<Vec3> values) {
+    count_ = values.size();
+    values_.clear();
+    for (const Vec3& v : values)
+        if (!v.isZero(0.0)) {
+            values_.swap(values);
+            return;
+        }
+    values_.shrink_to_fit();
 }
 
 }  // namespace dem

@@ -62,6 +62,8 @@ Simulation::Simulation(SimulationSettings settings, std::vector<Material> materi
     if (settings_.forces.cohesion == CohesionModel::Capillary)
         validateCapillaryParameters(settings_.forces.capillary, src);
     kernel_ = makeContactForceKernel(settings_.forces);
+    pairs_.setStateFields(PairStateFields::forModels(settings_.forces.rolling,
+                                                     settings_.forces.cohesion != CohesionModel::None));
 }
 
 void Simulation::insert(const std::vector<InsertedParticle>& inserted, int materialIndex, const Vec3& velocity,
@@ -158,6 +160,7 @@ void Simulation::setWaterContent(double w) {
     liquid_.poolVolume += volume - liquid_.totalVolume;
     liquid_.totalVolume = volume;
     liquidNetwork_ = std::make_unique<LiquidBridgeNetwork>(volume, settings_.bridges);
+    pairs_.setStateFields({pairs_.stateFields().rollingTorque, true});
     largestBridge_ = 0.0;
     forcesValid_ = false;
 }
@@ -180,7 +183,7 @@ struct CompensatedSum {
 
 double Simulation::liquidInBridges() const {
     CompensatedSum total;
-    for (const PairState& s : pairs_.state()) total.add(s.bridgeVolume);
+    for (double v : pairs_.bridgeVolume()) total.add(v);
     for (const WallContactRecord& r : wallContacts_.records()) total.add(r.bridgeVolume);
     return total.sum;
 }
@@ -233,7 +236,7 @@ void Simulation::removeLostParticles() {
         const auto& neighbors = pairs_.neighbors();
         for (std::size_t i = 0; i + 1 < offsets.size(); ++i)
             for (int k = offsets[i]; k < offsets[i + 1]; ++k)
-                if (!keep[i] || !keep[neighbors[k]]) liquid_.poolVolume += pairs_.state()[k].bridgeVolume;
+                if (!keep[i] || !keep[neighbors[k]]) liquid_.poolVolume += pairs_.bridgeVolume()[k];
         for (const WallContactRecord& r : wallContacts_.records())
             if (!keep[r.particle]) liquid_.poolVolume += r.bridgeVolume;
     }
@@ -328,13 +331,13 @@ void Simulation::redistributeLiquid(double wallReach) {
     BridgeCandidates candidates;
     const auto& offsets = pairs_.offsets();
     const auto& neighbors = pairs_.neighbors();
-    auto& state = pairs_.state();
+    std::vector<double>& bridge = pairs_.bridgeVolume();
     candidates.reserve(neighbors.size());
     for (std::size_t i = 0; i + 1 < offsets.size(); ++i)
         for (int k = offsets[i]; k < offsets[i + 1]; ++k) {
             const int j = neighbors[k];
             candidates.add(particles_.radius[i], particles_.radius[j],
-                           (particles_.position[i] - particles_.position[j]).norm(), state[k].bridgeVolume > 0.0);
+                           (particles_.position[i] - particles_.position[j]).norm(), bridge[k] > 0.0);
         }
     // Particle-wall bridges (option): the wall enters the distribution as a
     // mirror particle, the candidate (R, R, 2R + gap) -- it takes the share of a
@@ -353,14 +356,14 @@ void Simulation::redistributeLiquid(double wallReach) {
     largestBridge_ = 0.0;
     liquid_.bridgeCount = 0;
     liquid_.wallBridgeCount = 0;
-    for (std::size_t k = 0; k < state.size(); ++k) {
-        state[k].bridgeVolume = d.volume[k];
+    for (std::size_t k = 0; k < bridge.size(); ++k) {
+        bridge[k] = d.volume[k];
         largestBridge_ = std::max(largestBridge_, d.volume[k]);
         if (d.volume[k] > 0.0) ++liquid_.bridgeCount;
     }
     if (settings_.forces.wallBridges) {
         for (std::size_t m = 0; m < wallRecords.size(); ++m) {
-            const double volume = d.volume[state.size() + m];
+            const double volume = d.volume[bridge.size() + m];
             wallRecords[m].bridgeVolume = volume;
             largestBridge_ = std::max(largestBridge_, volume);
             if (volume > 0.0) ++liquid_.wallBridgeCount;
@@ -376,9 +379,11 @@ void Simulation::redistributeLiquid(double wallReach) {
 void Simulation::computeForces() {
     const std::size_t n = particles_.size();
     const Vec3 g = settings_.gravity;
+    const ParticleStore& p = particles_;  // reads of externalForce must not allocate it
+    const bool external = p.externalForce.allocated();
 #pragma omp parallel for schedule(static) num_threads(threadsFor(n, lightLoopParticlesPerThread))
     for (std::size_t i = 0; i < n; ++i) {
-        particles_.force[i] = particles_.mass[i] * g + particles_.externalForce[i];
+        particles_.force[i] = external ? Vec3(p.mass[i] * g + p.externalForce[i]) : Vec3(p.mass[i] * g);
         particles_.torque[i].setZero();
     }
     last_.contacts = kernel_->compute(particles_, pairs_, wallContacts_, walls_, wallCandidates_, interactions_,

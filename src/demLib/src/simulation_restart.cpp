@@ -51,7 +51,7 @@ void Simulation::writeRestart(const std::string& path) const {
         f.write("particles/omega", p.omega);
         f.write("particles/force", p.force);
         f.write("particles/torque", p.torque);
-        f.write("particles/externalForce", p.externalForce);
+        f.write("particles/externalForce", p.externalForce.toVector());
         f.write("particles/radius", p.radius);
         f.write("particles/mass", p.mass);
         f.write("particles/material", p.material);
@@ -63,10 +63,10 @@ void Simulation::writeRestart(const std::string& path) const {
         std::vector<double> bridge;
         const auto& offsets = pairs_.offsets();
         const auto& neighbors = pairs_.neighbors();
-        const auto& state = pairs_.state();
+        const PairStateView state = pairs_.state();
         for (std::size_t i = 0; i + 1 < offsets.size(); ++i)
             for (int k = offsets[i]; k < offsets[i + 1]; ++k) {
-                const PairState& s = state[k];
+                const PairState s = state[k];
                 if (s.bridgeVolume == 0.0 && s.contact.shear.isZero(0.0) && s.contact.rollingTorque.isZero(0.0))
                     continue;
                 ids.push_back(p.id[i]);
@@ -126,18 +126,15 @@ void Simulation::readRestart(const std::string& path) {
     p.omega = f.readVec3("particles/omega");
     p.force = f.readVec3("particles/force");
     p.torque = f.readVec3("particles/torque");
-    p.externalForce = f.readVec3("particles/externalForce");
+    p.externalForce.assign(f.readVec3("particles/externalForce"));
     p.radius = f.readDoubles("particles/radius");
     p.mass = f.readDoubles("particles/mass");
     p.material = f.readInts("particles/material");
     const std::size_t n = p.id.size();
-    if (p.position.size() != n || p.radius.size() != n || p.mass.size() != n || p.material.size() != n)
+    if (p.position.size() != n || p.radius.size() != n || p.mass.size() != n || p.material.size() != n ||
+        p.externalForce.size() != n)
         throw InputError("restart file '" + path + "': particle datasets have different lengths");
-    p.invMass.resize(n);
-    p.invInertia.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
-        p.invMass[i] = 1.0 / p.mass[i];
-        p.invInertia[i] = 1.0 / (0.4 * p.mass[i] * p.radius[i] * p.radius[i]);
         if (p.material[i] < 0 || p.material[i] >= static_cast<int>(materials_.size()))
             throw InputError("restart file '" + path + "': particle material index out of range");
     }
@@ -163,8 +160,10 @@ void Simulation::readRestart(const std::string& path) {
         wallContacts_.setBridgeReach(f.doubleAttribute("wallBridgeReach"));
     }
     liquidNetwork_.reset();
-    if (f.intAttribute("hasLiquid"))
+    if (f.intAttribute("hasLiquid")) {
         liquidNetwork_ = std::make_unique<LiquidBridgeNetwork>(liquid_.totalVolume, settings_.bridges);
+        pairs_.setStateFields({pairs_.stateFields().rollingTorque, true});
+    }
 
     std::unordered_map<std::int64_t, int> indexOf;
     indexOf.reserve(n);

@@ -69,7 +69,7 @@ struct ContactLaw {
     // extraNormalForce: cohesive normal force from another model (negative =
     // attractive).  It is always part of the returned force; it enters the
     // friction and rolling limits only if Settings::cohesionInFrictionLimits.
-    static ContactForces evaluate(const ContactKinematics& kin, const InteractionProperties& props,
+    DEM_ALWAYS_INLINE static ContactForces evaluate(const ContactKinematics& kin, const InteractionProperties& props,
                                   ContactHistory& history, double extraNormalForce = 0.0) noexcept {
         const double normalVelocity = kin.relVelocity.dot(kin.normal);
         const Vec3 tangentialVelocity = kin.relVelocity - normalVelocity * kin.normal;

@@ -13,6 +13,7 @@
 #include <cmath>
 
 #include "demLib/interaction_properties.hpp"
+#include "demLib/vec3.hpp"
 
 namespace dem {
 
@@ -28,7 +29,7 @@ struct HertzNormal {
 // sqrt(5/6), the factor that makes the Hertz dashpot reproduce e exactly.
 inline constexpr double kSqrtFiveSixths = 0.91287092917527685576;
 
-inline HertzNormal hertzNormal(double overlap, double normalVelocity, double radiusEff,
+DEM_ALWAYS_INLINE HertzNormal hertzNormal(double overlap, double normalVelocity, double radiusEff,
                                double massEff, const InteractionProperties& properties,
                                bool limitForce, bool tangentialDamping) noexcept {
     const double contactScale = std::sqrt(radiusEff * overlap);  // sqrt(R* d) = contact radius

@@ -53,7 +53,7 @@ inline double rollingInertiaWall(double mass, double radius) noexcept {
 //   if |M| > Mmax:  M *= Mmax/|M|, stored, returned without damping (full mobilisation)
 //   else:           stored; returned M - c w_t  with c = eta_r 2 sqrt(I_r kr) (EPSD) or 0 (EPSD2)
 // Mmax = mu_r R* |Fn| with Fn the total normal force of the normal model.
-inline Vec3 elasticPlasticRollingTorque(Vec3& springTorque, const Vec3& omega, const Vec3& normal,
+DEM_ALWAYS_INLINE Vec3 elasticPlasticRollingTorque(Vec3& springTorque, const Vec3& omega, const Vec3& normal,
                                         double dt, double rollingStiffness, double torqueLimit,
                                         double viscousCoefficient) noexcept {
     const Vec3 omegaTangential = omega - omega.dot(normal) * normal;

@@ -18,7 +18,7 @@ namespace dem {
 
 // Advances `shear` (metres, lives in ContactHistory) and returns the tangential
 // force on i.  frictionLimit = mu |Fn| >= 0 is decided by the caller.
-inline Vec3 tangentialHistoryForce(Vec3& shear, const Vec3& normal, const Vec3& tangentialVelocity,
+DEM_ALWAYS_INLINE Vec3 tangentialHistoryForce(Vec3& shear, const Vec3& normal, const Vec3& tangentialVelocity,
                                    double dt, double tangentialStiffness, double tangentialDamping,
                                    double frictionLimit) noexcept {
     shear += tangentialVelocity * dt;

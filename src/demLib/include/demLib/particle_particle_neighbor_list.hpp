@@ -1,11 +1,13 @@
 #pragma once
 // Particle-particle broad search: a linked-cell grid feeding a half Verlet list
 // (pairs i < j) with a skin, rebuilt when some particle has moved more than half
-// the skin since the last build.  Per-pair state (contact history, liquid
-// bridges) lives in arrays parallel to the list and is carried over at rebuild.
+// the skin since the last build.  Per-pair state (contact history of touching
+// pairs in a ContactHistoryPool, liquid bridge volumes in an array parallel to
+// the list) is carried over at rebuild.
 #include <cstdint>
 #include <vector>
 
+#include "demLib/contact_history_pool.hpp"
 #include "demLib/contact_law.hpp"
 #include "demLib/particle_store.hpp"
 
@@ -17,11 +19,65 @@ struct PairState {
     double bridgeVolume = 0.0;  // liquid held by a capillary bridge (0: none)
 };
 
+// Which parts of PairState a run keeps.  The list stores each part as its own
+// array parallel to the pairs; a part that is off costs no memory and reads as
+// zero: the rolling spring torque exists only for the EPSD models, the bridge
+// volume only with cohesion.  The tangential spring (shear) is always kept.
+struct PairStateFields {
+    bool rollingTorque = true;
+    bool bridgeVolume = true;
+    static PairStateFields forModels(RollingModel rolling, bool cohesion) {
+        return {rolling == RollingModel::EPSD || rolling == RollingModel::EPSD2, cohesion};
+    }
+    bool operator==(const PairStateFields& o) const {
+        return rollingTorque == o.rollingTorque && bridgeVolume == o.bridgeVolume;
+    }
+};
+
+// Read-only view of the pair state as PairState values (absent parts zero),
+// indexable like the pair list: for inspection, tests and restart files.
+class PairStateView {
+public:
+    PairStateView(const ContactHistoryPool& history, const std::vector<double>& bridge)
+        : history_(history), bridge_(bridge) {}
+    std::size_t size() const { return history_.entries(); }
+    PairState operator[](std::size_t k) const {
+        PairState s;
+        s.contact = history_.get(k);
+        if (!bridge_.empty()) s.bridgeVolume = bridge_[k];
+        return s;
+    }
+    class iterator {
+    public:
+        iterator(const PairStateView& v, std::size_t k) : v_(&v), k_(k) {}
+        PairState operator*() const { return (*v_)[k_]; }
+        iterator& operator++() {
+            ++k_;
+            return *this;
+        }
+        bool operator!=(const iterator& o) const { return k_ != o.k_; }
+
+    private:
+        const PairStateView* v_;
+        std::size_t k_;
+    };
+    iterator begin() const { return iterator(*this, 0); }
+    iterator end() const { return iterator(*this, size()); }
+
+private:
+    const ContactHistoryPool& history_;
+    const std::vector<double>& bridge_;
+};
+
 class ParticleParticleNeighborList {
 public:
     // skin: absolute distance added to the contact range; extraRange: extra
     // interaction range beyond contact (capillary debonding distance).
     void setRanges(double skin, double extraRange);
+    // Which pair-state parts to keep (default: all).  Changing them drops or
+    // zero-fills the affected arrays.
+    void setStateFields(const PairStateFields& fields);
+    const PairStateFields& stateFields() const { return fields_; }
     double skin() const { return skin_; }
     double extraRange() const { return extraRange_; }
 
@@ -42,8 +98,13 @@ public:
     // The pair list, CSR by first particle: for i, entries [offsets[i], offsets[i+1]).
     const std::vector<int>& offsets() const { return offsets_; }
     const std::vector<int>& neighbors() const { return neighbors_; }
-    std::vector<PairState>& state() { return state_; }
-    const std::vector<PairState>& state() const { return state_; }
+    // Pair state: contact history of the pairs in contact, and the bridge
+    // volume per listed pair (empty when stateFields() leaves it out).
+    ContactHistoryPool& history() { return history_; }
+    const ContactHistoryPool& history() const { return history_; }
+    std::vector<double>& bridgeVolume() { return bridgeVolume_; }
+    const std::vector<double>& bridgeVolume() const { return bridgeVolume_; }
+    PairStateView state() const { return PairStateView(history_, bridgeVolume_); }
     const std::vector<Vec3>& positionsAtBuild() const { return positionAtBuild_; }
     std::size_t pairCount() const { return neighbors_.size(); }
     long buildCount() const { return buildCount_; }
@@ -52,8 +113,11 @@ public:
     // build, so restoring those and rebuilding reproduces it exactly.
     void restore(const ParticleStore& particles, const std::vector<Vec3>& positionAtBuild,
                  long buildCount);
-    // Installs saved pair state for pair (i, j), i < j, after restore().
+    // Installs saved pair state for pair (i, j), i < j, after restore(); parts
+    // the list does not keep are ignored.
     bool setState(int i, int j, const PairState& s);
+    // The same for list entry k (offsets()/neighbors() order).
+    void setStateAt(std::size_t k, const PairState& s);
 
     std::size_t bytes() const;
 
@@ -65,7 +129,9 @@ private:
     double extraRange_ = 0.0;
     std::vector<int> offsets_{0};
     std::vector<int> neighbors_;
-    std::vector<PairState> state_;
+    PairStateFields fields_;
+    ContactHistoryPool history_;
+    std::vector<double> bridgeVolume_;
     std::vector<Vec3> positionAtBuild_;
     long buildCount_ = 0;
 };

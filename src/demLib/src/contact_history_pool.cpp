@@ -1,0 +1,85 @@
+#include "demLib/contact_history_pool.hpp"
+
+namespace dem {
+
+namespace {
+std::size_t grownCapacity(std::size_t used) { return used + used / 8 + 64; }
+}  // namespace
+
+void ContactHistoryPool::setRolling(bool keep) {
+    if (keep == rolling_) return;
+    const std::size_t slots = slotCount();
+    const std::size_t oldStride = stride();
+    rolling_ = keep;
+    // Re-pack the records with the new stride (shear kept, rolling torque zero).
+    std::vector<double> data(slots * stride(), 0.0);
+    for (std::size_t s = 0; s < slots; ++s)
+        for (int c = 0; c < 3; ++c) data[s * stride() + c] = data_[s * oldStride + c];
+    data_.swap(data);
+}
+
+void ContactHistoryPool::reset(std::size_t entries) {
+    slot_.assign(entries, -1);
+    data_.clear();
+    free_.clear();
+}
+
+void ContactHistoryPool::rebuild(const std::vector<int>& from, const std::vector<char>& flip,
+                                 const std::vector<char>& touching) {
+    // Count first, so that the new records are allocated once and exactly,
+    // with room for contacts that close before the next build.
+    std::size_t used = 0;
+    for (std::size_t b = 0; b < from.size(); ++b)
+        if ((from[b] >= 0 && slot_[from[b]] >= 0) || (!touching.empty() && touching[b])) ++used;
+    const std::size_t width = stride();
+    std::vector<int> slot(from.size(), -1);
+    std::vector<double> data;
+    data.reserve(grownCapacity(used) * width);
+    data.resize(used * width, 0.0);
+    int next = 0;
+    for (std::size_t b = 0; b < from.size(); ++b) {
+        const int old = from[b] >= 0 ? slot_[from[b]] : -1;
+        if (old < 0 && (touching.empty() || !touching[b])) continue;
+        slot[b] = next;
+        if (old >= 0) {
+            const double sign = !flip.empty() && flip[b] ? -1.0 : 1.0;
+            for (std::size_t c = 0; c < width; ++c) data[next * width + c] = sign * data_[old * width + c];
+        }
+        ++next;
+    }
+    slot_.swap(slot);
+    data_.swap(data);
+    free_.clear();
+}
+
+int ContactHistoryPool::takeSlot() {
+    if (!free_.empty()) {
+        const int s = free_.back();
+        free_.pop_back();
+        return s;
+    }
+    // Grow by an eighth, not the doubling of vector: the records are a large
+    // part of the memory, and a copy holds the old and new block at once.
+    if (data_.size() == data_.capacity()) data_.reserve(grownCapacity(slotCount()) * stride());
+    data_.resize(data_.size() + stride(), 0.0);
+    return static_cast<int>(slotCount()) - 1;
+}
+
+void ContactHistoryPool::set(std::size_t k, const ContactHistory& h) {
+    if (slot_[k] < 0) slot_[k] = takeSlot();
+    double* r = record(slot_[k]);
+    Vec3::Map(r) = h.shear;
+    if (rolling_) Vec3::Map(r + 3) = h.rollingTorque;
+}
+
+void ContactHistoryPool::commit(const std::vector<Changes>& changes) {
+    for (const Changes& c : changes) free_.insert(free_.end(), c.released.begin(), c.released.end());
+    for (const Changes& c : changes)
+        for (const Changes::Opened& o : c.opened) set(o.entry, o.history);
+}
+
+std::size_t ContactHistoryPool::bytes() const {
+    return slot_.capacity() * sizeof(int) + data_.capacity() * sizeof(double) + free_.capacity() * sizeof(int);
+}
+
+}  // namespace dem

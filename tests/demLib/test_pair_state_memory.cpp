@@ -1,0 +1,183 @@
+// Memory layout of the pair state and the particle store (issue 7): contact
+// history only for pairs in contact (ContactHistoryPool), the rolling spring
+// only for the EPSD models, bridge volumes only with cohesion, and the external
+// force allocated on first write.
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "demLib/contact_history_pool.hpp"
+#include "demLib/simulation.hpp"
+#include "thread_count.hpp"
+
+namespace {
+
+using dem::Vec3;
+
+dem::ContactHistory history(double s, double r) {
+    dem::ContactHistory h;
+    h.shear = Vec3(s, 2 * s, 3 * s);
+    h.rollingTorque = Vec3(r, -r, 0.5 * r);
+    return h;
+}
+
+void expectHistory(const dem::ContactHistory& h, const dem::ContactHistory& expected) {
+    EXPECT_EQ(h.shear, expected.shear);
+    EXPECT_EQ(h.rollingTorque, expected.rollingTorque);
+}
+
+TEST(ContactHistoryPool, SlotsOnlyForPairsWithHistory) {
+    dem::ContactHistoryPool pool;
+    pool.reset(4);
+    EXPECT_EQ(pool.slotsInUse(), 0u);
+    pool.set(1, history(1.0, 10.0));
+    pool.set(3, history(3.0, 30.0));
+    EXPECT_EQ(pool.slotsInUse(), 2u);
+    expectHistory(pool.get(0), history(0.0, 0.0));
+    expectHistory(pool.get(1), history(1.0, 10.0));
+    expectHistory(pool.get(3), history(3.0, 30.0));
+
+    // A force loop: pair 1 opened (slot returned), pair 2 closed (new history).
+    std::vector<dem::ContactHistoryPool::Changes> changes(2);
+    const int freed = pool.slots()[1];
+    pool.slots()[1] = -1;
+    changes[0].released.push_back(freed);
+    changes[1].opened.push_back({2, history(2.0, 20.0)});
+    pool.commit(changes);
+    EXPECT_EQ(pool.slotsInUse(), 2u);
+    EXPECT_EQ(pool.slots()[2], freed);  // the returned slot is reused, the pool does not grow
+    expectHistory(pool.get(1), history(0.0, 0.0));
+    expectHistory(pool.get(2), history(2.0, 20.0));
+
+    // A list rebuild: new entry 0 is old pair 3 seen from its other particle,
+    // entry 1 is new, entry 2 is new but already touching, entry 3 is old pair 2.
+    pool.rebuild({3, -1, -1, 2}, {1, 0, 0, 0}, {0, 0, 1, 0});
+    EXPECT_EQ(pool.entries(), 4u);
+    EXPECT_EQ(pool.slotsInUse(), 3u);
+    expectHistory(pool.get(0), history(-3.0, -30.0));
+    EXPECT_EQ(pool.slots()[1], -1);
+    EXPECT_GE(pool.slots()[2], 0);
+    expectHistory(pool.get(2), history(0.0, 0.0));
+    expectHistory(pool.get(3), history(2.0, 20.0));
+    // Slots are handed out in list order at a rebuild.
+    EXPECT_LT(pool.slots()[0], pool.slots()[2]);
+    EXPECT_LT(pool.slots()[2], pool.slots()[3]);
+
+    // Without the rolling spring the records shrink; the shear stays.
+    const std::size_t withRolling = pool.bytes();
+    pool.setRolling(false);
+    EXPECT_EQ(pool.stride(), 3u);
+    EXPECT_LT(pool.bytes(), withRolling);
+    expectHistory(pool.get(3), dem::ContactHistory{history(2.0, 0.0).shear, Vec3::Zero()});
+}
+
+dem::Simulation twoTouchingAndOneNear(dem::RollingModel rolling, dem::CohesionModel cohesion) {
+    dem::SimulationSettings s;
+    s.timeStep = 1e-6;
+    s.gravity = Vec3::Zero();
+    s.forces.rolling = rolling;
+    s.forces.cohesion = cohesion;
+    s.source = "test_pair_state_memory";
+    const std::vector<dem::Material> mats{{"glass", 5e6, 0.3, 2500.0}};
+    dem::PairCoefficients c;
+    c.restitution = 0.5;
+    c.friction = 0.5;
+    c.rollingFriction = 0.1;
+    dem::InteractionTable table(1);
+    table.set(mats, 0, 0, c);
+    dem::Simulation sim(s, mats, table, {});
+    const double r = 1e-3;
+    // 0 and 1 overlap by 1 um and slide past each other; 2 is 0.1 mm away from 1
+    // (inside the skin of 0.4 mm): listed, not touching.
+    sim.insert({{Vec3(0, 0, 0), r}}, 0, Vec3(0, 0.01, 0));
+    sim.insert({{Vec3(2 * r - 1e-6, 0, 0), r}}, 0, Vec3(0, -0.01, 0));
+    sim.insert({{Vec3(4 * r - 1e-6 + 1e-4, 0, 0), r}}, 0, Vec3::Zero());
+    return sim;
+}
+
+TEST(PairStateMemory, HistoryOnlyForTouchingPairsAndOnlyTheModelsParts) {
+    ThreadCount threads(1);
+    dem::Simulation sim = twoTouchingAndOneNear(dem::RollingModel::EPSD2, dem::CohesionModel::None);
+    sim.particles().omega[0] = Vec3(0, 0, 50.0);  // rolls on 1: the rolling spring winds up
+    sim.step(20);
+    const auto& list = sim.pairList();
+    EXPECT_TRUE(list.stateFields().rollingTorque);
+    EXPECT_FALSE(list.stateFields().bridgeVolume);
+    EXPECT_TRUE(list.bridgeVolume().empty());
+    ASSERT_EQ(list.pairCount(), 2u);  // (0,1) touching and (1,2) within the skin
+    EXPECT_EQ(sim.lastStep().contacts.touchingPairs, 1u);
+    EXPECT_EQ(list.history().slotsInUse(), 1u);
+    const dem::PairState touching = list.state()[0];  // pair (0, 1)
+    const dem::PairState near = list.state()[1];      // pair (1, 2)
+    // Particle 0 moves +y relative to 1: the tangential spring stretches along +y.
+    EXPECT_GT(touching.contact.shear.y(), 0.0);
+    EXPECT_GT(touching.contact.rollingTorque.norm(), 0.0);
+    EXPECT_EQ(near.contact.shear, Vec3::Zero());
+    EXPECT_EQ(near.contact.rollingTorque, Vec3::Zero());
+
+    // CDT keeps no rolling spring, and dry runs no bridge volumes.
+    dem::Simulation cdt = twoTouchingAndOneNear(dem::RollingModel::CDT, dem::CohesionModel::None);
+    cdt.step(20);
+    dem::Simulation epsd2 = twoTouchingAndOneNear(dem::RollingModel::EPSD2, dem::CohesionModel::None);
+    epsd2.step(20);
+    EXPECT_FALSE(cdt.pairList().stateFields().rollingTorque);
+    EXPECT_EQ(cdt.pairList().history().stride(), 3u);
+    EXPECT_EQ(cdt.pairList().state()[0].contact.rollingTorque, Vec3::Zero());
+    EXPECT_GT(cdt.pairList().state()[0].contact.shear.y(), 0.0);
+    // Without spin the tangential spring does not depend on the rolling model.
+    EXPECT_EQ(cdt.pairList().state()[0].contact.shear, epsd2.pairList().state()[0].contact.shear);
+
+    // The capillary model keeps a bridge volume per listed pair.
+    dem::Simulation wet = twoTouchingAndOneNear(dem::RollingModel::None, dem::CohesionModel::Capillary);
+    EXPECT_TRUE(wet.pairList().stateFields().bridgeVolume);
+    wet.step(1);
+    EXPECT_EQ(wet.pairList().bridgeVolume().size(), wet.pairList().pairCount());
+}
+
+TEST(PairStateMemory, ContactThatOpensReturnsItsSlot) {
+    ThreadCount threads(1);
+    dem::Simulation sim = twoTouchingAndOneNear(dem::RollingModel::EPSD2, dem::CohesionModel::None);
+    sim.particles().velocity[0] = Vec3(-0.05, 0, 0);  // 0 leaves 1: 1 um in 20 us
+    sim.step(100);
+    EXPECT_EQ(sim.lastStep().contacts.touchingPairs, 0u);
+    EXPECT_EQ(sim.pairList().history().slotsInUse(), 0u);
+    for (const dem::PairState& s : sim.pairList().state()) EXPECT_EQ(s.contact.shear, Vec3::Zero());
+}
+
+TEST(ExternalForceField, AllocatedOnFirstWriteAndFollowsTheParticles) {
+    dem::ParticleStore p;
+    for (int i = 0; i < 3; ++i) p.add(i, Vec3(i, 0, 0), Vec3::Zero(), 1e-3, 2500.0, 0);
+    const std::size_t dryBytes = p.bytesPerParticle();
+    EXPECT_FALSE(p.externalForce.allocated());
+    EXPECT_EQ(p.externalForce.size(), 3u);
+    const dem::ParticleStore& view = p;
+    EXPECT_EQ(view.externalForce[1], Vec3::Zero());
+    EXPECT_FALSE(p.externalForce.allocated());  // reading does not allocate
+
+    p.externalForce[2] = Vec3(1, 2, 3);
+    EXPECT_TRUE(p.externalForce.allocated());
+    EXPECT_EQ(p.bytesPerParticle(), dryBytes + sizeof(Vec3));
+    EXPECT_EQ(view.externalForce[0], Vec3::Zero());
+    p.permute({2, 0, 1});
+    EXPECT_EQ(view.externalForce[0], Vec3(1, 2, 3));
+    EXPECT_EQ(p.id[0], 2);
+    p.compact({0, 1, 1});
+    EXPECT_EQ(p.externalForce.size(), 2u);
+    EXPECT_EQ(view.externalForce[0], Vec3::Zero());
+    p.add(7, Vec3::Zero(), Vec3::Zero(), 1e-3, 2500.0, 0);
+    EXPECT_EQ(p.externalForce.size(), 3u);
+    EXPECT_EQ(view.externalForce[2], Vec3::Zero());
+}
+
+TEST(ExternalForceField, AcceleratesTheParticleInASimulation) {
+    ThreadCount threads(1);
+    dem::Simulation sim = twoTouchingAndOneNear(dem::RollingModel::None, dem::CohesionModel::None);
+    const double m = sim.particles().mass[2];
+    const double a = 3.0;  // m/s^2 along z on the free particle 2
+    sim.particles().externalForce[2] = Vec3(0, 0, m * a);
+    sim.step(10);
+    EXPECT_NEAR(sim.particles().velocity[2].z(), a * 10 * sim.timeStep(), 1e-12);
+    EXPECT_EQ(sim.particles().velocity[0].z(), 0.0);
+}
+
+}  // namespace
