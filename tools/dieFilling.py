@@ -220,7 +220,8 @@ def main():
                                 extent=(-1.3 * radius, 1.3 * radius), band=radius / 4)
     centre = profile.fit_line(x, h, (-radius / 2, radius / 2))
     border = (x >= 0.8 * radius) & (x <= radius) & np.isfinite(h)
-    right_height = float(np.mean(h[border])) if border.any() else 0.0
+    right_height = float(np.mean(h[border])) if border.any() else None
+    top = float(np.nanmax(h)) if np.isfinite(h).any() else None
     # The right border stands close to vertical: measured from the bed's edge position vs
     # height, which a height profile cannot resolve.
     right = None
@@ -250,9 +251,12 @@ def main():
                              "description": ("edge position vs height fitted over heights [%.1f, %.1f] mm "
                                              "above the base" % tuple(w * 1e3 for w in right["window"])
                                              if right else "no edge found") + " (paper: about 90)"},
-        "rightBorderHeight": {"value": round(right_height * 1e3, 3), "unit": "mm",
+        "rightBorderHeight": {"value": round(right_height * 1e3, 3) if right_height is not None else None,
+                              "unit": "mm",
                               "description": "mean bed height above the base over x in [0.8 R, R] after "
-                                             "the opening (a bed that stands keeps its height to its edge)"},
+                                             "the opening (none: no powder there)"},
+        "bedHeight": {"value": round(top * 1e3, 3) if top is not None else None, "unit": "mm",
+                      "description": "highest point of the surface profile after the opening"},
         "massPoured": {"value": poured, "unit": "kg"},
         "massInDieFilled": {"value": mass_die_filled, "unit": "kg", "description": f"at t = {opening} s"},
         "fillRatioFilled": {"value": mass_die_filled / poured, "unit": "-"},

@@ -138,6 +138,14 @@ int main(int argc, char *argv[])
         progress.update();
     }
 
+    // The end time is written even when it is not a multiple of writeInterval,
+    // with the particle forces that go with it (a later continuation needs both)
+    if (!runTime.writeTime())
+    {
+        runTime.writeNow();
+        coupling.write();
+    }
+
     coupling.finish();
 
     Info<< "End\n" << endl;
