@@ -316,4 +316,45 @@ TEST(EngineInput, TooLargeTimeStepIsRejectedNamingBothValues) {
     EXPECT_EQ(forced.particles().size(), 1u);
 }
 
+TEST(EngineInput, HertzLimitBindsAtHighImpactVelocity) {
+    // At 50 m/s impacts the Hertz collision time of two glass spheres is shorter
+    // than the Rayleigh time: 0.1 x Hertz is the binding limit, and a step
+    // between the two limits must be refused naming the Hertz value.
+    OneThread oneThread;
+    const std::vector<dem::Material> mats{glass()};
+    dem::PairCoefficients c;
+    dem::SimulationSettings settings = noGravity(1e-9);
+    settings.impactVelocity = 50.0;
+    const double mass = 4.0 / 3.0 * kPi * kRadius * kRadius * kRadius * 2500.0;
+    // Y* of two equal spheres: E / (2 (1 - nu^2)); head-on at twice the impact speed
+    const double yStar = 5e6 / (2.0 * (1.0 - 0.3 * 0.3));
+    const double hertz = dem::hertzCollisionTime(mass, 0.5 * kRadius, yStar, 2.0 * 50.0);
+    const double rayleigh = dem::rayleighTime(kRadius, 2500.0, 5e6, 0.3);
+    const double hertzLimit = 0.1 * hertz;
+    ASSERT_LT(hertzLimit, 0.2 * rayleigh);  // the case tests what it says
+    {
+        dem::Simulation probe(settings, mats, tableFor(mats, c), {});
+        probe.insert({{Vec3::Zero(), kRadius}}, 0, Vec3::Zero());
+        EXPECT_NEAR(probe.maxAllowedTimeStep(), hertzLimit, 1e-12 * hertzLimit);
+        EXPECT_NEAR(probe.timeStepLimits().hertz, hertzLimit, 1e-12 * hertzLimit);
+        EXPECT_NEAR(probe.timeStepLimits().rayleigh, 0.2 * rayleigh, 1e-12 * rayleigh);
+    }
+    settings.timeStep = 0.5 * (hertzLimit + 0.2 * rayleigh);  // allowed by Rayleigh only
+    dem::Simulation sim(settings, mats, tableFor(mats, c), {});
+    try {
+        sim.insert({{Vec3::Zero(), kRadius}}, 0, Vec3::Zero());
+        FAIL() << "no InputError";
+    } catch (const dem::InputError& e) {
+        const std::string what = e.what();
+        std::ostringstream hertzText;
+        hertzText << hertzLimit;
+        EXPECT_NE(what.find("Hertz"), std::string::npos) << what;
+        EXPECT_NE(what.find("impactVelocity"), std::string::npos) << what;
+        EXPECT_NE(what.find(hertzText.str()), std::string::npos) << what << " lacks " << hertzText.str();
+    }
+    settings.timeStep = 0.99 * hertzLimit;
+    dem::Simulation fine(settings, mats, tableFor(mats, c), {});
+    EXPECT_NO_THROW(fine.insert({{Vec3::Zero(), kRadius}}, 0, Vec3::Zero()));
+}
+
 }  // namespace
