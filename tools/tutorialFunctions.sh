@@ -62,17 +62,28 @@ tutorial_prepare() {
     echo "    setting: $SETTING, rolling model: $ROLLING, $THREADS thread(s)"
 }
 
-tutorial_run_demRun() {
-    local start=$SECONDS status=0
-    rm -rf dem log.demRun
-    OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-passive} "${DEMRUN:-demRun}" -case "$PWD" -threads "$THREADS" > /dev/null 2>&1 || status=$?
+# tutorial_timed_run NAME LOG COMMAND...: runs COMMAND, wall time in TUTORIAL_DEM_SECONDS;
+# on failure prints the end of LOG and exits with the command's status.
+tutorial_timed_run() {
+    local name=$1 log=$2 start=$SECONDS status=0
+    shift 2
+    "$@" || status=$?
     TUTORIAL_DEM_SECONDS=$((SECONDS - start))
     if [ "$status" -ne 0 ]; then
-        echo "$(basename "$PWD"): demRun failed (exit $status); last lines of log.demRun:" >&2
-        tail -n 20 log.demRun >&2
+        echo "$(basename "$PWD"): $name failed (exit $status); last lines of $log:" >&2
+        tail -n 30 "$log" >&2
         exit "$status"
     fi
-    echo "    demRun: ok (${TUTORIAL_DEM_SECONDS} s, log.demRun)"
+    echo "    $name: ok (${TUTORIAL_DEM_SECONDS} s, $log)"
+}
+
+# demRun writes log.demRun itself (with its progress lines and ETA)
+_tutorial_demRun() { "${DEMRUN:-demRun}" -case "$PWD" -threads "$THREADS" > /dev/null 2>&1; }
+_tutorial_diefillFoam() { diefillFoam >> log.diefillFoam 2>&1; }
+
+tutorial_run_demRun() {
+    rm -rf dem log.demRun
+    OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-passive} tutorial_timed_run demRun log.demRun _tutorial_demRun
 }
 
 # Time folders of the air after 0, in order
@@ -105,16 +116,9 @@ tutorial_prepare_air() {
 }
 
 tutorial_run_diefillFoam() {
-    local start=$SECONDS status=0
     [ -d dem/restart ] && [ -n "$(tutorial_air_times)" ] || rm -rf dem
-    OMP_NUM_THREADS=$THREADS OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-passive} diefillFoam >> log.diefillFoam 2>&1 || status=$?
-    TUTORIAL_DEM_SECONDS=$((SECONDS - start))
-    if [ "$status" -ne 0 ]; then
-        echo "$(basename "$PWD"): diefillFoam failed (exit $status); last lines of log.diefillFoam:" >&2
-        tail -n 30 log.diefillFoam >&2
-        exit "$status"
-    fi
-    echo "    diefillFoam: ok (${TUTORIAL_DEM_SECONDS} s, log.diefillFoam)"
+    OMP_NUM_THREADS=$THREADS OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-passive} \
+        tutorial_timed_run diefillFoam log.diefillFoam _tutorial_diefillFoam
 }
 
 tutorial_clean_air() {
