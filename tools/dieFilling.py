@@ -247,6 +247,11 @@ def main():
         "centralAngle": {"value": round(centre["angle"], 2), "unit": "deg",
                          "description": f"fit over x in [{-radius / 2 * 1e3:.1f}, {radius / 2 * 1e3:.1f}] mm "
                                         "(paper: 33.8 measured, 32.9 simulated)"},
+        "centralFitRms": {"value": round(centre["rms"] * 1e3, 3), "unit": "mm",
+                          "description": "rms distance of the central profile points from the fitted line: a "
+                                         "large value (compared with a grain, %.2f mm) means the surface there is "
+                                         "not a plane slope and the angle is not meaningful"
+                                         % (float(np.mean(2 * final.radius)) * 1e3)},
         "rightBorderAngle": {"value": round(right["angle"], 2) if right else None, "unit": "deg",
                              "description": ("edge position vs height fitted over heights [%.1f, %.1f] mm "
                                              "above the base" % tuple(w * 1e3 for w in right["window"])
@@ -285,9 +290,9 @@ def main():
     if a.runTime is not None:
         res["runTime"] = {"value": a.runTime, "unit": "s", "description": "wall time of demRun"}
     results.write(case, res)
-    print("dieFilling (%s, %s): central angle %.1f deg, right border %s deg, fill ratio %.3f, "
+    print("dieFilling (%s, %s): central angle %.1f deg (fit rms %.1f mm), right border %s deg, fill ratio %.3f, "
           "lost at opening %.1f %%, die 50 %% / 90 %% full at t = %s / %s s"
-          % ("wet" if wet else "dry", "air" if with_air else "vacuum", centre["angle"],
+          % ("wet" if wet else "dry", "air" if with_air else "vacuum", centre["angle"], centre["rms"] * 1e3,
              f"{right['angle']:.1f}" if right else "n/a", mass_die_filled / poured,
              100 * lost_at_opening / max(mass_die_filled, 1e-30),
              f"{t50:.3f}" if t50 is not None else "n/a", f"{t90:.3f}" if t90 is not None else "n/a"))
