@@ -41,7 +41,29 @@
 #include "demLib/error.hpp"
 #include "demLib/simulation.hpp"
 
+#include <cstring>
+
 namespace {
+
+// FNV-1a over the bits of positions, velocities and spins: two builds that
+// claim bitwise identical results must print the same value.
+unsigned long long stateHash(const dem::ParticleStore& p) {
+    unsigned long long h = 1469598103934665603ULL;
+    auto add = [&](const std::vector<dem::Vec3>& v) {
+        for (const dem::Vec3& x : v)
+            for (int c = 0; c < 3; ++c) {
+                unsigned long long bits;
+                const double value = x[c];
+                std::memcpy(&bits, &value, sizeof bits);
+                h = (h ^ bits) * 1099511628211ULL;
+            }
+    };
+    add(p.position);
+    add(p.velocity);
+    add(p.omega);
+    return h;
+}
+
 
 constexpr double pi = 3.14159265358979323846;
 
@@ -331,7 +353,8 @@ int timeSteps(const Options& o) {
               << "result pair_list_bytes_per_particle " << static_cast<double>(sim->pairList().bytes()) / n << "\n"
               << "result rss_growth_bytes_per_particle "
               << (static_cast<double>(procStatusBytes("VmRSS")) - static_cast<double>(rssBefore)) / n << "\n"
-              << "result vmhwm_bytes " << procStatusBytes("VmHWM") << std::endl;
+              << "result vmhwm_bytes " << procStatusBytes("VmHWM") << "\n"
+              << "result state_hash " << std::hex << stateHash(p) << std::dec << std::endl;
     return 0;
 }
 

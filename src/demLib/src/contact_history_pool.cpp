@@ -1,5 +1,7 @@
 #include "demLib/contact_history_pool.hpp"
 
+#include <algorithm>
+
 namespace dem {
 
 namespace {
@@ -50,6 +52,59 @@ void ContactHistoryPool::rebuild(const std::vector<int>& from, const std::vector
     slot_.swap(slot);
     data_.swap(data);
     free_.clear();
+}
+
+void ContactHistoryPool::repack(std::vector<int>& source) {
+    const std::size_t width = stride();
+    const int oldSlots = static_cast<int>(slotCount());
+    // New slots in list order; fresh ones remembered.
+    int used = 0;
+    std::vector<int> fresh;
+    for (int& s : source) {
+        if (s == -1) continue;
+        if (s == freshRecord) fresh.push_back(used);
+        ++used;
+    }
+    const int span = std::max(oldSlots, used);
+    // Where each record goes: carried records to their new slot; the rest (old
+    // records no entry continues, and room beyond the old records) fill the
+    // fresh slots first and then the tail, which is cut off at the end.
+    // free_ is cleared by a rebuild anyway: its memory serves as the map.
+    std::vector<int>& target = free_;
+    target.assign(span, -1);
+    {
+        int next = 0;
+        for (int& s : source) {
+            if (s == -1) continue;
+            if (s >= 0) target[s] = next;
+            s = next++;
+        }
+    }
+    {
+        std::size_t f = 0;
+        int tail = used;
+        for (int r = 0; r < span; ++r)
+            if (target[r] < 0) target[r] = f < fresh.size() ? fresh[f++] : tail++;
+    }
+    if (data_.capacity() < static_cast<std::size_t>(span) * width) {
+        // More contacts than records (rare): grow once, with the usual room.
+        std::vector<double> grown;
+        grown.reserve(grownCapacity(span) * width);
+        grown.assign(data_.begin(), data_.end());
+        data_.swap(grown);
+    }
+    data_.resize(static_cast<std::size_t>(span) * width, 0.0);
+    // Apply the permutation by cycles: each swap puts one record in place.
+    for (int r = 0; r < span; ++r)
+        while (target[r] != r) {
+            const int t = target[r];
+            std::swap_ranges(&data_[r * width], &data_[r * width] + width, &data_[t * width]);
+            std::swap(target[r], target[t]);
+        }
+    for (int s : fresh) std::fill_n(&data_[s * width], width, 0.0);
+    data_.resize(static_cast<std::size_t>(used) * width);  // capacity kept: room for new contacts
+    free_.clear();
+    slot_.swap(source);
 }
 
 int ContactHistoryPool::takeSlot() {

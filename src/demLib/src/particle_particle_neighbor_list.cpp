@@ -13,29 +13,6 @@
 
 namespace dem {
 
-namespace {
-
-// For each entry of the new list, the entry of the old list holding the same
-// pair (-1: new pair).  Both lists are sorted by j within each i: a merge.
-std::vector<int> matchOldEntries(const std::vector<int>& oldOffsets, const std::vector<int>& oldNeighbors,
-                                 const std::vector<int>& offsets, const std::vector<int>& neighbors,
-                                 bool canTransfer) {
-    std::vector<int> from(neighbors.size(), -1);
-    if (!canTransfer) return from;
-    const int oldN = static_cast<int>(oldOffsets.size()) - 1;
-#pragma omp parallel for schedule(static) num_threads(threadsFor(oldN, lightLoopParticlesPerThread))
-    for (int i = 0; i < oldN; ++i) {
-        int a = oldOffsets[i];
-        const int aEnd = oldOffsets[i + 1];
-        for (int b = offsets[i]; b < offsets[i + 1] && a < aEnd; ++b) {
-            while (a < aEnd && oldNeighbors[a] < neighbors[b]) ++a;
-            if (a < aEnd && oldNeighbors[a] == neighbors[b]) from[b] = a;
-        }
-    }
-    return from;
-}
-
-}  // namespace
 
 void ParticleParticleNeighborList::setStateFields(const PairStateFields& fields) {
     if (fields == fields_) return;
@@ -105,16 +82,19 @@ void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
     const int n = static_cast<int>(particles.size());
     // Rows listed (first particles of pairs): all but MPI ghosts.
     const int rows = static_cast<int>(std::min(listedRows, particles.size()));
-    std::vector<int> oldOffsets;
-    std::vector<int> oldNeighbors;
-    oldOffsets.swap(offsets_);
-    oldNeighbors.swap(neighbors_);
     // Particles appended since the last build (insertion) have no old pairs.
-    const int oldN = static_cast<int>(oldOffsets.size()) - 1;
+    const int oldN = static_cast<int>(offsets_.size()) - 1;
     const bool canTransfer = oldN >= 0 && oldN <= n;
-
-    offsets_.assign(n + 1, 0);
+    if (!canTransfer) {
+        offsets_.assign(1, 0);
+        neighbors_.clear();
+        history_.reset(0);
+        bridgeVolume_.clear();
+    }
+    std::vector<int> newOffsets(n + 1, 0);
     if (n == 0) {
+        offsets_.swap(newOffsets);
+        neighbors_.clear();
         history_.reset(0);
         bridgeVolume_.clear();
         return;
@@ -124,18 +104,28 @@ void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
     // surrounding cells need a look.
     double rMax = 0.0;
     for (int i = 0; i < n; ++i) rMax = std::max(rMax, particles.radius[i]);
-    const CellBins bins = binIntoCells(positions, 2.0 * rMax + skin_ + extraRange_);
+    CellBins bins = binIntoCells(positions, 2.0 * rMax + skin_ + extraRange_);
     const int nx = bins.nx, ny = bins.ny, nz = bins.nz;
     const std::vector<int>& cellOf = bins.cellOf;
     const std::vector<int>& cellStart = bins.cellStart;
     const std::vector<int>& cellParticles = bins.particles;
 
-    // Each thread lists a contiguous block of i; blocks are joined in order, so
-    // the list does not depend on the thread count.
+    // Each thread lists a contiguous block of i into its own buffers; blocks
+    // are joined in order, so the list does not depend on the thread count.
+    // Each new row is merged with the old row of the same particle (both
+    // sorted by j) as it is made: a pair that stays listed takes its history
+    // slot and bridge volume along, a new pair already in contact gets a zero
+    // record.  So no old-to-new entry map is needed, and the old list and
+    // history slots are dead once the blocks are complete.
     const int threads = threadsFor(rows, heavyLoopParticlesPerThread);
-    std::vector<std::vector<int>> blockNeighbors(threads);
-    std::vector<int> count(n, 0);
+    blocks_.resize(threads);
     const double reach = skin_ + extraRange_;
+    const int* oldOffsets = offsets_.data();
+    const int* oldNeighbors = neighbors_.data();
+    const int* oldSlots = history_.slots();
+    const double* oldBridge = bridgeVolume_.data();
+    const bool keepBridges = fields_.bridgeVolume;
+    const int transferRows = canTransfer ? oldN : 0;
 #pragma omp parallel num_threads(threads)
     {
 #ifdef _OPENMP
@@ -145,9 +135,21 @@ void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
 #endif
         const int begin = static_cast<int>(static_cast<long>(rows) * t / threads);
         const int end = static_cast<int>(static_cast<long>(rows) * (t + 1) / threads);
-        std::vector<int>& out = blockNeighbors[t];
-        out.reserve(static_cast<std::size_t>(end - begin) * 8);
-        std::vector<int> mine;
+        BuildBlock& out = blocks_[t];
+        out.neighbors.clear();
+        out.slotSource.clear();
+        out.bridgeVolume.clear();
+        // Room for the old block's pairs and an eighth more (the first build:
+        // eight per particle); later builds reuse the buffers' memory.
+        const int lo = std::min(begin, transferRows), hi = std::min(end, transferRows);
+        const std::size_t expected = transferRows > 0 ? static_cast<std::size_t>(oldOffsets[hi] - oldOffsets[lo]) * 9 / 8 + 64
+                                                      : static_cast<std::size_t>(end - begin) * 8;
+        if (out.neighbors.capacity() < expected) {
+            out.neighbors.reserve(expected);
+            out.slotSource.reserve(expected);
+        }
+        if (keepBridges && out.bridgeVolume.capacity() < expected) out.bridgeVolume.reserve(expected);
+        std::vector<int>& mine = out.row;
         for (int i = begin; i < end; ++i) {
             mine.clear();
             const int c = cellOf[i];
@@ -174,45 +176,59 @@ void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
                 }
             }
             std::sort(mine.begin(), mine.end());
-            count[i] = static_cast<int>(mine.size());
-            out.insert(out.end(), mine.begin(), mine.end());
+            newOffsets[i + 1] = static_cast<int>(mine.size());
+            int a = i < transferRows ? oldOffsets[i] : 0;
+            const int aEnd = i < transferRows ? oldOffsets[i + 1] : 0;
+            for (const int j : mine) {
+                while (a < aEnd && oldNeighbors[a] < j) ++a;
+                const int old = a < aEnd && oldNeighbors[a] == j ? a : -1;
+                int source = old >= 0 ? oldSlots[old] : -1;
+                if (source < 0) {
+                    // Pairs in contact now get their record here, in list
+                    // order; only contacts that close later take slots out of order.
+                    const double contact = ri + particles.radius[j];
+                    if ((positions[j] - xi).squaredNorm() < contact * contact)
+                        source = ContactHistoryPool::freshRecord;
+                }
+                out.neighbors.push_back(j);
+                out.slotSource.push_back(source);
+                if (keepBridges) out.bridgeVolume.push_back(old >= 0 ? oldBridge[old] : 0.0);
+            }
         }
     }
-    for (int i = 0; i < n; ++i) offsets_[i + 1] = offsets_[i] + count[i];
-    std::vector<int>().swap(count);
-    if (threads == 1) {
-        neighbors_.swap(blockNeighbors[0]);
-        neighbors_.shrink_to_fit();
-    } else {
-        neighbors_.reserve(offsets_[n]);
-        for (auto& block : blockNeighbors) {
-            neighbors_.insert(neighbors_.end(), block.begin(), block.end());
-            std::vector<int>().swap(block);
-        }
-    }
+    // The cells are not needed any more: free them before the list is joined.
+    std::vector<int>().swap(bins.cellOf);
+    std::vector<int>().swap(bins.cellStart);
+    std::vector<int>().swap(bins.particles);
+    for (int i = 0; i < n; ++i) newOffsets[i + 1] += newOffsets[i];
+    offsets_.swap(newOffsets);
+    std::vector<int>().swap(newOffsets);
 
-    const std::vector<int> from = matchOldEntries(oldOffsets, oldNeighbors, offsets_, neighbors_, canTransfer);
-    std::vector<int>().swap(oldOffsets);
-    std::vector<int>().swap(oldNeighbors);
-    if (fields_.bridgeVolume) {
-        std::vector<double> bridge(neighbors_.size(), 0.0);
-        if (canTransfer)
-            for (std::size_t b = 0; b < from.size(); ++b)
-                if (from[b] >= 0) bridge[b] = bridgeVolume_[from[b]];
-        bridgeVolume_.swap(bridge);
-    }
-    // Pairs in contact now get their history slot here, in list order; only
-    // contacts that close later take slots out of order.
-    std::vector<char> touching(neighbors_.size(), 0);
-#pragma omp parallel for schedule(static) num_threads(threadsFor(n, lightLoopParticlesPerThread))
-    for (int i = 0; i < n; ++i)
-        for (int k = offsets_[i]; k < offsets_[i + 1]; ++k) {
-            const int j = neighbors_[k];
-            const double contact = particles.radius[i] + particles.radius[j];
-            touching[k] = (positions[j] - positions[i]).squaredNorm() < contact * contact;
+    if (threads == 1) {
+        // The old arrays become the block's buffers for the next build.
+        neighbors_.swap(blocks_[0].neighbors);
+        if (keepBridges) bridgeVolume_.swap(blocks_[0].bridgeVolume);
+        history_.repack(blocks_[0].slotSource);
+    } else {
+        // The old list is dead: its memory takes the joined one.
+        neighbors_.clear();
+        neighbors_.reserve(offsets_[n]);
+        for (const BuildBlock& block : blocks_)
+            neighbors_.insert(neighbors_.end(), block.neighbors.begin(), block.neighbors.end());
+        if (keepBridges) {
+            bridgeVolume_.clear();
+            bridgeVolume_.reserve(offsets_[n]);
+            for (const BuildBlock& block : blocks_)
+                bridgeVolume_.insert(bridgeVolume_.end(), block.bridgeVolume.begin(), block.bridgeVolume.end());
         }
-    if (!canTransfer) history_.reset(0);
-    history_.rebuild(from, {}, touching);
+        std::vector<int> source = history_.releaseSlots();
+        source.clear();
+        source.reserve(offsets_[n]);
+        for (const BuildBlock& block : blocks_)
+            source.insert(source.end(), block.slotSource.begin(), block.slotSource.end());
+        history_.repack(source);
+    }
+    if (!keepBridges) bridgeVolume_.clear();
 }
 
 void ParticleParticleNeighborList::remap(const std::vector<int>& oldToNew) {
@@ -268,7 +284,16 @@ void ParticleParticleNeighborList::remap(const std::vector<int>& oldToNew) {
 
 std::size_t ParticleParticleNeighborList::bytes() const {
     return offsets_.capacity() * sizeof(int) + neighbors_.capacity() * sizeof(int) +
-           history_.bytes() + bridgeVolume_.capacity() * sizeof(double) + positionAtBuild_.capacity() * sizeof(Vec3);
+           history_.bytes() + bridgeVolume_.capacity() * sizeof(double) + positionAtBuild_.capacity() * sizeof(Vec3) +
+           buildBufferBytes();
+}
+
+std::size_t ParticleParticleNeighborList::buildBufferBytes() const {
+    std::size_t bytes = 0;
+    for (const BuildBlock& b : blocks_)
+        bytes += (b.neighbors.capacity() + b.slotSource.capacity() + b.row.capacity()) * sizeof(int) +
+                 b.bridgeVolume.capacity() * sizeof(double);
+    return bytes;
 }
 
 }  // namespace dem

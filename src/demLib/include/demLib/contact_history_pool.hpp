@@ -33,6 +33,17 @@ public:
     // empty) reserves a zero slot for a pair already in contact.
     void rebuild(const std::vector<int>& from, const std::vector<char>& flip, const std::vector<char>& touching);
 
+    // The list was rebuilt (pairs keep their orientation): source[b] is the
+    // slot whose record new entry b continues, freshRecord for a pair already
+    // in contact that gets a zero record, -1 for none.  The records are
+    // permuted into list order in place (no second copy of them); on return
+    // `source` holds the old slot array, as a buffer for the next build.
+    static constexpr int freshRecord = -2;
+    void repack(std::vector<int>& source);
+    // Hands out the slot array (the pool then has no entries), e.g. to reuse
+    // its memory once the slots were copied elsewhere.
+    std::vector<int> releaseSlots() { return std::move(slot_); }
+
     std::size_t entries() const { return slot_.size(); }
     ContactHistory get(std::size_t k) const {
         ContactHistory h;

@@ -119,11 +119,23 @@ public:
     // The same for list entry k (offsets()/neighbors() order).
     void setStateAt(std::size_t k, const PairState& s);
 
+    // Memory held, including the build buffers kept for the next build.
     std::size_t bytes() const;
+    std::size_t buildBufferBytes() const;
 
 private:
     void buildFrom(const ParticleStore& particles, const std::vector<Vec3>& positions,
                    std::size_t listedRows = static_cast<std::size_t>(-1));
+
+    // What one thread lists at a build (its block of rows), kept between
+    // builds so that a rebuild allocates nothing new in the steady state.
+    struct BuildBlock {
+        std::vector<int> neighbors;
+        std::vector<int> slotSource;  // see ContactHistoryPool::repack
+        std::vector<double> bridgeVolume;
+        std::vector<int> row;  // neighbours of one particle, sorted
+    };
+    std::vector<BuildBlock> blocks_;
 
     double skin_ = 0.0;
     double extraRange_ = 0.0;

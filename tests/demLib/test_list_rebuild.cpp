@@ -1,0 +1,229 @@
+// Neighbour-list rebuild without a second copy of the pair state (issue 7):
+// ContactHistoryPool::repack permutes the history records in place, and
+// ParticleParticleNeighborList::build merges each new row with the old one
+// (history slot and bridge volume carried directly), reusing its per-thread
+// buffers between builds.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iterator>
+#include <map>
+#include <random>
+#include <set>
+#include <utility>
+#include <vector>
+
+#include "demLib/contact_history_pool.hpp"
+#include "demLib/particle_particle_neighbor_list.hpp"
+#include "thread_count.hpp"
+
+namespace {
+
+using dem::Vec3;
+
+dem::ContactHistory history(double s, double r) {
+    dem::ContactHistory h;
+    h.shear = Vec3(s, 2 * s, 3 * s);
+    h.rollingTorque = Vec3(r, -r, 0.5 * r);
+    return h;
+}
+
+void expectHistory(const dem::ContactHistory& h, const dem::ContactHistory& expected) {
+    EXPECT_EQ(h.shear, expected.shear);
+    EXPECT_EQ(h.rollingTorque, expected.rollingTorque);
+}
+
+TEST(ContactHistoryPool, RepackPermutesTheRecordsInPlaceInListOrder) {
+    dem::ContactHistoryPool pool;
+    pool.reset(6);
+    // Slots taken out of list order (as contacts close during a run), one
+    // returned: records 0..4 hold entries 4, 2, 0, 5, 1; entry 5's is freed.
+    for (int k : {4, 2, 0, 5, 1}) pool.set(k, history(k + 1.0, 10.0 * (k + 1)));
+    std::vector<dem::ContactHistoryPool::Changes> changes(1);
+    changes[0].released.push_back(pool.slots()[5]);
+    pool.slots()[5] = -1;
+    pool.commit(changes);
+    ASSERT_EQ(pool.slotsInUse(), 4u);
+    const double* recordsBefore = pool.record(0);
+
+    // New list of 5 entries: old entries 1, 4 and 0 continue (in that order),
+    // entry 1 is a new pair already in contact, entry 3 a new pair apart; old
+    // entry 2 left the list.
+    const std::vector<int> oldSlots(pool.slots(), pool.slots() + 6);
+    std::vector<int> source{oldSlots[1], dem::ContactHistoryPool::freshRecord, oldSlots[4], -1, oldSlots[0]};
+    pool.repack(source);
+    EXPECT_EQ(source, oldSlots);  // the old slot array comes back as a buffer
+    EXPECT_EQ(pool.entries(), 5u);
+    EXPECT_EQ(pool.slotsInUse(), 4u);
+    EXPECT_EQ(pool.record(0), recordsBefore);  // same memory: no second copy of the records
+    // Slots in list order, the records moved with them.
+    EXPECT_EQ(pool.slots()[0], 0);
+    EXPECT_EQ(pool.slots()[1], 1);
+    EXPECT_EQ(pool.slots()[2], 2);
+    EXPECT_EQ(pool.slots()[3], -1);
+    EXPECT_EQ(pool.slots()[4], 3);
+    expectHistory(pool.get(0), history(2.0, 20.0));
+    expectHistory(pool.get(1), history(0.0, 0.0));
+    expectHistory(pool.get(2), history(5.0, 50.0));
+    expectHistory(pool.get(3), history(0.0, 0.0));
+    expectHistory(pool.get(4), history(1.0, 10.0));
+
+    // More contacts than records: the pool grows, fresh records are zero even
+    // where a dropped record's values lay before.
+    std::vector<int> grow(8, dem::ContactHistoryPool::freshRecord);
+    grow[6] = 2;  // old entry 2 (history 5, 50)
+    grow[0] = 0;  // old entry 0 (history 2, 20)
+    pool.repack(grow);
+    EXPECT_EQ(pool.slotsInUse(), 8u);
+    expectHistory(pool.get(0), history(2.0, 20.0));
+    expectHistory(pool.get(6), history(5.0, 50.0));
+    for (int k : {1, 2, 3, 4, 5, 7}) expectHistory(pool.get(k), history(0.0, 0.0));
+    for (int k = 0; k < 8; ++k) EXPECT_EQ(pool.slots()[k], k);
+    // New contacts after the rebuild still get slots.
+    pool.set(7, history(9.0, 90.0));
+    expectHistory(pool.get(7), history(9.0, 90.0));
+}
+
+// A jittered cubic lattice of spheres, some pairs overlapping.
+dem::ParticleStore jitteredLattice(int side, double radius, double jitter, unsigned seed) {
+    dem::ParticleStore p;
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(-jitter, jitter);
+    int id = 0;
+    for (int z = 0; z < side; ++z)
+        for (int y = 0; y < side; ++y)
+            for (int x = 0; x < side; ++x) {
+                const Vec3 at(2.0 * radius * x + u(rng), 2.0 * radius * y + u(rng), 2.0 * radius * z + u(rng));
+                p.add(id, at, Vec3::Zero(), radius * (1.0 + 0.2 * (id % 3)), 2500.0, 0);
+                ++id;
+            }
+    return p;
+}
+
+// All pairs (i < j) closer than r_i + r_j + skin, by brute force.
+std::vector<std::pair<int, int>> allPairs(const dem::ParticleStore& p, double skin) {
+    std::vector<std::pair<int, int>> pairs;
+    const int n = static_cast<int>(p.size());
+    for (int i = 0; i < n; ++i)
+        for (int j = i + 1; j < n; ++j) {
+            const double range = p.radius[i] + p.radius[j] + skin;
+            if ((p.position[j] - p.position[i]).squaredNorm() < range * range) pairs.emplace_back(i, j);
+        }
+    return pairs;
+}
+
+std::vector<std::pair<int, int>> listedPairs(const dem::ParticleParticleNeighborList& list) {
+    std::vector<std::pair<int, int>> pairs;
+    for (std::size_t i = 0; i + 1 < list.offsets().size(); ++i)
+        for (int k = list.offsets()[i]; k < list.offsets()[i + 1]; ++k) pairs.emplace_back(static_cast<int>(i), list.neighbors()[k]);
+    return pairs;
+}
+
+// Builds, gives every listed pair a history and bridge volume derived from
+// (i, j), moves the particles, rebuilds twice; returns the final list's pairs
+// with their state.
+struct RebuildResult {
+    std::vector<std::pair<int, int>> pairs;
+    std::vector<dem::PairState> state;
+    std::vector<int> slots;
+};
+
+RebuildResult rebuildTwice(int threads) {
+    ThreadCount scope(threads);
+    const double radius = 1e-3, skin = 0.4e-3;
+    dem::ParticleStore p = jitteredLattice(14, radius, 0.3e-3, 7);
+    dem::ParticleParticleNeighborList list;
+    list.setRanges(skin, 0.0);
+    list.setStateFields({true, true});
+    // Pairs in contact at some build: they got a (zero) record then.
+    std::set<std::pair<int, int>> touchedAtABuild;
+    auto noteTouching = [&] {
+        for (const auto& [i, j] : listedPairs(list)) {
+            const double contact = p.radius[i] + p.radius[j];
+            if ((p.position[j] - p.position[i]).squaredNorm() < contact * contact) touchedAtABuild.insert({i, j});
+        }
+    };
+    list.build(p);
+    EXPECT_EQ(listedPairs(list), allPairs(p, skin));
+    noteTouching();
+    std::map<std::pair<int, int>, dem::PairState> given;
+    for (std::size_t i = 0; i + 1 < list.offsets().size(); ++i)
+        for (int k = list.offsets()[i]; k < list.offsets()[i + 1]; ++k) {
+            const int j = list.neighbors()[k];
+            if ((i + j) % 3 == 0) continue;  // some pairs without history
+            dem::PairState s;
+            s.contact = history(1e-6 * (i + 1), 1e-9 * (j + 1));
+            s.bridgeVolume = 1e-12 * (i + 2 * j);
+            list.setStateAt(k, s);
+            given[{static_cast<int>(i), j}] = s;
+        }
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(-0.25e-3, 0.25e-3);
+    for (int round = 0; round < 2; ++round) {
+        for (Vec3& x : p.position) x += Vec3(u(rng), u(rng), u(rng));
+        list.build(p);
+        EXPECT_EQ(listedPairs(list), allPairs(p, skin));
+        noteTouching();
+        // A pair that left the list has lost its state for good.
+        const std::vector<std::pair<int, int>> now = listedPairs(list);
+        for (auto it = given.begin(); it != given.end();)
+            it = std::binary_search(now.begin(), now.end(), it->first) ? std::next(it) : given.erase(it);
+    }
+    EXPECT_GT(list.buildBufferBytes(), 0u);
+
+    RebuildResult r;
+    r.pairs = listedPairs(list);
+    for (std::size_t k = 0; k < r.pairs.size(); ++k) {
+        r.state.push_back(list.state()[k]);
+        r.slots.push_back(list.history().slots()[k]);
+        const auto [i, j] = r.pairs[k];
+        const auto it = given.find({i, j});
+        const dem::PairState s = list.state()[k];
+        if (it != given.end()) {
+            // Listed all along (else it would have lost its state): carried over.
+            expectHistory(s.contact, it->second.contact);
+            EXPECT_EQ(s.bridgeVolume, it->second.bridgeVolume);
+        } else {
+            expectHistory(s.contact, history(0.0, 0.0));
+            EXPECT_EQ(s.bridgeVolume, 0.0);
+        }
+        // A pair in contact at the build has a record (zero if new); one that
+        // was given no history and touched at no build has none.
+        const double contact = p.radius[i] + p.radius[j];
+        const bool touching = (p.position[j] - p.position[i]).squaredNorm() < contact * contact;
+        if (touching) {
+            EXPECT_GE(list.history().slots()[k], 0) << i << ' ' << j;
+        } else if (it == given.end() && !touchedAtABuild.count({i, j})) {
+            EXPECT_EQ(list.history().slots()[k], -1) << i << ' ' << j;
+        }
+    }
+    // Records in list order after a build.
+    int last = -1;
+    for (int s : r.slots)
+        if (s >= 0) {
+            EXPECT_EQ(s, last + 1);
+            last = s;
+        }
+    return r;
+}
+
+TEST(ParticleParticleNeighborList, RebuildCarriesPairStateAndDoesNotDependOnThreads) {
+    const RebuildResult one = rebuildTwice(1);
+    const RebuildResult two = rebuildTwice(2);
+    ASSERT_GT(one.pairs.size(), 5000u);
+    // Some pairs survived with their state, some were dropped or are new.
+    std::size_t carried = 0;
+    for (const dem::PairState& s : one.state) carried += s.bridgeVolume > 0.0;
+    EXPECT_GT(carried, one.pairs.size() / 4);
+    EXPECT_LT(carried, one.pairs.size());
+    EXPECT_EQ(one.pairs, two.pairs);
+    EXPECT_EQ(one.slots, two.slots);
+    ASSERT_EQ(one.state.size(), two.state.size());
+    for (std::size_t k = 0; k < one.state.size(); ++k) {
+        expectHistory(one.state[k].contact, two.state[k].contact);
+        EXPECT_EQ(one.state[k].bridgeVolume, two.state[k].bridgeVolume);
+    }
+}
+
+}  // namespace
