@@ -153,17 +153,16 @@ def air_plot(path, curves, summary_t, solid_volume_in_die, opening):
     plt.close(fig)
 
 
-def shoe_pass_window(case):
+def shoe_pass_window(props):
     """(start, end) of the shoe's motion (walls/shoe/motion in demProperties), or None."""
-    shoe = foamdict.read_case(case)["walls"].get("shoe", {})
+    shoe = props["walls"].get("shoe", {})
     segments = [s for s in shoe.get("motion", {}).values() if isinstance(s, dict)]
     if not segments:
         return None
     return min(float(s["start"]) for s in segments), max(float(s["end"]) for s in segments)
 
 
-def die_geometry(case):
-    d = foamdict.read_case(case)
+def die_geometry(d):
     wall = d["walls"]["dieWall"]
     radius = float(wall["radius"])
     z0, z1 = (float(v) for v in wall["range"])
@@ -183,7 +182,8 @@ def main():
     ap.add_argument("-runTime", type=float, default=None, help="wall time of the run [s], for the summary")
     a = ap.parse_args()
     case = a.case
-    radius, height, base_z, opening = die_geometry(case)
+    props = foamdict.read_case(case)          # constant/demProperties
+    radius, height, base_z, opening = die_geometry(props)
     if a.openingStart is not None:
         opening = a.openingStart
     if opening is None:
@@ -203,13 +203,13 @@ def main():
     lost_before_opening = float(s["lostMass"][before][-1])
     lost_at_opening = lost_total - lost_before_opening
     fill = summary.fill_ratio(s["mass_die"], poured)
-    shoe_pass = shoe_pass_window(case)
+    shoe_pass = shoe_pass_window(props)
     during = (t >= shoe_pass[0]) & (t <= shoe_pass[1]) if shoe_pass else np.zeros(len(t), bool)
     mean_fill_pass = float(np.mean(np.asarray(fill)[during])) if during.any() else None
     t50 = first_time_reaching(t, np.asarray(fill), 0.5)
     t90 = first_time_reaching(t, np.asarray(fill), 0.9)
     with_air = os.path.isdir(os.path.join(case, "constant", "polyMesh"))
-    wet = "cohesion" in foamdict.read_case(case)
+    wet = "cohesion" in props
 
     final = series.read_frame(frames[-1][1])
     filled = series.read_frame(min(frames, key=lambda e: abs(e[0] - opening))[1])
@@ -280,7 +280,7 @@ def main():
     }
     if with_air:
         rho = float(foamdict.read(os.path.join(case, "constant", "transportProperties"))["rho"])
-        density = float(foamdict.read_case(case)["materials"]["sand"]["density"])
+        density = float(props["materials"]["sand"]["density"])
         res.update(air_results(case, rho, opening, out, t, np.asarray(s["mass_die"]) / density))
         res["shoeBedWeightPerArea"] = {"value": round(poured * 9.81 / (np.pi * radius**2), 3), "unit": "Pa",
                                        "description": "weight of the powder in the shoe over the shoe's "

@@ -279,6 +279,25 @@ TEST(EngineInput, NonPositiveRadiusIsRejected) {
     }
 }
 
+// Inserts one sphere at the origin and returns the InputError's message (a
+// failure is recorded if the insertion is accepted).
+std::string rejectedInsertion(dem::Simulation& sim) {
+    try {
+        sim.insert({{Vec3::Zero(), kRadius}}, 0, Vec3::Zero());
+    } catch (const dem::InputError& e) {
+        return e.what();
+    }
+    ADD_FAILURE() << "no InputError";
+    return "";
+}
+
+// A number as the error messages print it (default ostream formatting).
+std::string printed(double value) {
+    std::ostringstream s;
+    s << value;
+    return s.str();
+}
+
 TEST(EngineInput, TooLargeTimeStepIsRejectedNamingBothValues) {
     OneThread oneThread;
     const std::vector<dem::Material> mats{glass()};
@@ -291,19 +310,11 @@ TEST(EngineInput, TooLargeTimeStepIsRejectedNamingBothValues) {
     const double dt = 3.0 * allowed;
     dem::SimulationSettings settings = noGravity(dt);
     dem::Simulation sim(settings, mats, tableFor(mats, c), {});
-    try {
-        sim.insert({{Vec3::Zero(), kRadius}}, 0, Vec3::Zero());
-        FAIL() << "no InputError";
-    } catch (const dem::InputError& e) {
-        const std::string what = e.what();
-        std::ostringstream dtText, allowedText;
-        dtText << dt;
-        allowedText << allowed;
-        EXPECT_NE(what.find("timeStep"), std::string::npos) << what;
-        EXPECT_NE(what.find(dtText.str()), std::string::npos) << what << " lacks " << dtText.str();
-        EXPECT_NE(what.find(allowedText.str()), std::string::npos) << what << " lacks " << allowedText.str();
-        EXPECT_NE(what.find("expected"), std::string::npos) << what;
-    }
+    const std::string what = rejectedInsertion(sim);
+    EXPECT_NE(what.find("timeStep"), std::string::npos) << what;
+    EXPECT_NE(what.find(printed(dt)), std::string::npos) << what << " lacks " << printed(dt);
+    EXPECT_NE(what.find(printed(allowed)), std::string::npos) << what << " lacks " << printed(allowed);
+    EXPECT_NE(what.find("expected"), std::string::npos) << what;
     EXPECT_EQ(sim.particles().size(), 0u);  // a rejected insertion adds nothing
     // Just below the limit is accepted.
     dem::Simulation fine(noGravity(0.99 * allowed), mats, tableFor(mats, c), {});
@@ -325,7 +336,7 @@ TEST(EngineInput, HertzLimitBindsAtHighImpactVelocity) {
     dem::PairCoefficients c;
     dem::SimulationSettings settings = noGravity(1e-9);
     settings.impactVelocity = 50.0;
-    const double mass = 4.0 / 3.0 * kPi * kRadius * kRadius * kRadius * 2500.0;
+    const double mass = sphereMass(kRadius, 2500.0);
     // Y* of two equal spheres: E / (2 (1 - nu^2)); head-on at twice the impact speed
     const double yStar = 5e6 / (2.0 * (1.0 - 0.3 * 0.3));
     const double hertz = dem::hertzCollisionTime(mass, 0.5 * kRadius, yStar, 2.0 * 50.0);
@@ -341,17 +352,10 @@ TEST(EngineInput, HertzLimitBindsAtHighImpactVelocity) {
     }
     settings.timeStep = 0.5 * (hertzLimit + 0.2 * rayleigh);  // allowed by Rayleigh only
     dem::Simulation sim(settings, mats, tableFor(mats, c), {});
-    try {
-        sim.insert({{Vec3::Zero(), kRadius}}, 0, Vec3::Zero());
-        FAIL() << "no InputError";
-    } catch (const dem::InputError& e) {
-        const std::string what = e.what();
-        std::ostringstream hertzText;
-        hertzText << hertzLimit;
-        EXPECT_NE(what.find("Hertz"), std::string::npos) << what;
-        EXPECT_NE(what.find("impactVelocity"), std::string::npos) << what;
-        EXPECT_NE(what.find(hertzText.str()), std::string::npos) << what << " lacks " << hertzText.str();
-    }
+    const std::string what = rejectedInsertion(sim);
+    EXPECT_NE(what.find("Hertz"), std::string::npos) << what;
+    EXPECT_NE(what.find("impactVelocity"), std::string::npos) << what;
+    EXPECT_NE(what.find(printed(hertzLimit)), std::string::npos) << what << " lacks " << printed(hertzLimit);
     settings.timeStep = 0.99 * hertzLimit;
     dem::Simulation fine(settings, mats, tableFor(mats, c), {});
     EXPECT_NO_THROW(fine.insert({{Vec3::Zero(), kRadius}}, 0, Vec3::Zero()));

@@ -8,23 +8,15 @@
 
 #include "demLib/contact_history_pool.hpp"
 #include "demLib/simulation.hpp"
+#include "contact_history_testing.hpp"
 #include "thread_count.hpp"
 
 namespace {
 
 using dem::Vec3;
 
-dem::ContactHistory history(double s, double r) {
-    dem::ContactHistory h;
-    h.shear = Vec3(s, 2 * s, 3 * s);
-    h.rollingTorque = Vec3(r, -r, 0.5 * r);
-    return h;
-}
-
-void expectHistory(const dem::ContactHistory& h, const dem::ContactHistory& expected) {
-    EXPECT_EQ(h.shear, expected.shear);
-    EXPECT_EQ(h.rollingTorque, expected.rollingTorque);
-}
+using dem_testing::expectHistory;
+using dem_testing::history;
 
 TEST(ContactHistoryPool, SlotsOnlyForPairsWithHistory) {
     dem::ContactHistoryPool pool;

@@ -42,15 +42,17 @@ class _Parser:
             return float(tok)
         return tok
 
+    def _parse_item(self, toks, i, scopes):
+        """One list element or entry value at toks[i]: a (nested) list or a scalar."""
+        if toks[i] == "(":
+            return self._parse_list(toks, i + 1, scopes)
+        return self._value(toks[i], scopes), i + 1
+
     def _parse_list(self, toks, i, scopes):
         out = []
         while toks[i] != ")":
-            if toks[i] == "(":
-                sub, i = self._parse_list(toks, i + 1, scopes)
-                out.append(sub)
-            else:
-                out.append(self._value(toks[i], scopes))
-                i += 1
+            item, i = self._parse_item(toks, i, scopes)
+            out.append(item)
         return out, i + 1
 
     def _parse_entries(self, toks, i, scopes, base, top=False):
@@ -80,12 +82,8 @@ class _Parser:
                 if toks[i] == "[":  # dimension sets are not tokenised separately; skip
                     i += 1
                     continue
-                if toks[i] == "(":
-                    sub, i = self._parse_list(toks, i + 1, scopes)
-                    values.append(sub)
-                else:
-                    values.append(self._value(toks[i], scopes))
-                    i += 1
+                item, i = self._parse_item(toks, i, scopes)
+                values.append(item)
             d[key] = values[-1] if values else None
             i += 1
         return d, i
