@@ -41,27 +41,57 @@ public:
         const int threads = threadsFor(n, heavyLoopParticlesPerThread);
         // Thread 0 accumulates into the particle arrays; the others into their own
         // buffers, added afterwards in thread order: the sums, and so the results,
-        // are the same in every run with the same thread count.
+        // are the same in every run with the same thread count.  The buffers are
+        // kept zero between steps (the reduction below clears what it adds), so
+        // no serial clearing pass is needed.
         buffers_.resize(threads);
         for (int t = 1; t < threads; ++t) {
-            buffers_[t].force.assign(n, Vec3::Zero());
-            buffers_[t].torque.assign(n, Vec3::Zero());
+            if (buffers_[t].force.size() != static_cast<std::size_t>(n)) {
+                buffers_[t].force.assign(n, Vec3::Zero());
+                buffers_[t].torque.assign(n, Vec3::Zero());
+            }
         }
         std::vector<ContactStatistics> stats(threads);
         changes_.resize(threads);
         for (auto& c : changes_) c.clear();
-        std::vector<std::vector<WallContactRecord>> newWall(threads);
+        newWall_.resize(threads);
+        for (auto& w : newWall_) w.clear();
+        auto& newWall = newWall_;
+        // Rows are split at equal numbers of listed pairs, not of particles
+        // (the pair loop is most of the work and its rows differ in length).
+        const int* offsets = pairs.offsets().data();
+        const long listed = offsets[n];
+        auto rowSplit = [&](int t) {
+            if (t == 0) return 0;
+            if (t == threads) return n;
+            const long target = listed * t / threads;
+            return static_cast<int>(std::lower_bound(offsets, offsets + n, target) - offsets);
+        };
 
 #pragma omp parallel num_threads(threads)
         {
             const int t = threadIndex();
             Vec3* force = t == 0 ? p.force.data() : buffers_[t].force.data();
             Vec3* torque = t == 0 ? p.torque.data() : buffers_[t].torque.data();
-            const int begin = static_cast<int>(static_cast<long>(n) * t / threads);
-            const int end = static_cast<int>(static_cast<long>(n) * (t + 1) / threads);
+            const int begin = rowSplit(t);
+            const int end = rowSplit(t + 1);
             pairForces(p, pairs, interactions, dt, begin, end, force, torque, stats[t], changes_[t]);
             wallForces(p, wallContacts, walls, wallCandidates, interactions, time, dt, begin, end, force,
                        torque, newWall[t], stats[t]);
+            if (threads > 1) {
+                // The other threads' sums, added in thread order in the same
+                // parallel region (no second fork), and cleared for the next step.
+#pragma omp barrier
+#pragma omp for schedule(static)
+                for (int i = 0; i < n; ++i) {
+                    for (int u = 1; u < threads; ++u) {
+                        p.force[i] += buffers_[u].force[i];
+                        p.torque[i] += buffers_[u].torque[i];
+                        buffers_[u].force[i].setZero();
+                        buffers_[u].torque[i].setZero();
+                    }
+                }
+            }
         }
 
         pairs.history().commit(changes_);
@@ -75,13 +105,6 @@ public:
             total.wallBridges += stats[t].wallBridges;
             total.releasedLiquid += stats[t].releasedLiquid;
             wallCount += newWall[t].size();
-        }
-        for (int t = 1; t < threads; ++t) {
-#pragma omp parallel for schedule(static) num_threads(threadsFor(n, lightLoopParticlesPerThread))
-            for (int i = 0; i < n; ++i) {
-                p.force[i] += buffers_[t].force[i];
-                p.torque[i] += buffers_[t].torque[i];
-            }
         }
         auto& records = wallContacts.records();
         records.clear();
@@ -97,6 +120,7 @@ private:
     };
     std::vector<Buffer> buffers_;
     std::vector<ContactHistoryPool::Changes> changes_;  // per thread, reused
+    std::vector<std::vector<WallContactRecord>> newWall_;  // per thread, reused
 
     void pairForces(ParticleStore& p, ParticleParticleNeighborList& pairs,
                     const InteractionTable& interactions, double dt, int begin, int end, Vec3* force,
@@ -117,6 +141,7 @@ private:
                 slot[k] = -1;
             }
         };
+        std::size_t touchingPairs = 0;  // a register, not a store per contact
         for (int i = begin; i < end; ++i) {
             const Vec3 xi = p.position[i];
             const double ri = p.radius[i];
@@ -135,7 +160,7 @@ private:
                     }
                 }
                 const double dist = std::sqrt(dist2);
-                const Vec3 normal = d / dist;
+                const Vec3 normal = d * (1.0 / dist);  // one division, not three
                 const double overlap = radiusSum - dist;
 
                 double cohesiveForce = 0.0;
@@ -162,15 +187,20 @@ private:
                         continue;
                     }
                 }
-                ++stats.touchingPairs;
+                ++touchingPairs;
                 // Lever arms to the contact point, as LIGGGHTS (radius − δ/2).
                 const double ci = ri - 0.5 * overlap;
                 const double cj = rj - 0.5 * overlap;
                 ContactKinematics kin;
                 kin.normal = normal;
                 kin.overlap = overlap;
-                kin.radiusEff = ri * rj / radiusSum;
-                kin.massEff = p.mass[i] * p.mass[j] / (p.mass[i] + p.mass[j]);
+                // R* = ri rj / (ri + rj) and m* = mi mj / (mi + mj) with one division.
+                const double mi = p.mass[i];
+                const double mj = p.mass[j];
+                const double massSum = mi + mj;
+                const double inverseSums = 1.0 / (radiusSum * massSum);
+                kin.radiusEff = ri * rj * massSum * inverseSums;
+                kin.massEff = mi * mj * radiusSum * inverseSums;
                 kin.relVelocity = p.velocity[i] - p.velocity[j] - (ci * p.omega[i] + cj * p.omega[j]).cross(normal);
                 kin.relOmega = p.omega[i] - p.omega[j];
                 kin.dt = dt;
@@ -202,6 +232,7 @@ private:
             force[i] += fi;
             torque[i] += ti;
         }
+        stats.touchingPairs += touchingPairs;
     }
 
     void wallForces(ParticleStore& p, const ParticleWallContacts& old, const std::vector<Wall>& walls,

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "demLib/contact_normal_hertz.hpp"  // kSqrtFiveSixths
 #include "demLib/error.hpp"
 
 namespace dem {
@@ -74,6 +75,11 @@ InteractionProperties makeInteraction(const Material& a, const Material& b,
     properties.friction = coefficients.friction;
     properties.rollingFriction = coefficients.rollingFriction;
     properties.rollingViscousDamping = coefficients.rollingViscousDamping;
+    const double dampingPrefactor = -2.0 * kSqrtFiveSixths * properties.beta;
+    properties.normalStiffnessFactor = 4.0 / 3.0 * properties.youngsEff;
+    properties.tangentialStiffnessFactor = 8.0 * properties.shearEff;
+    properties.normalDampingFactor = dampingPrefactor * std::sqrt(2.0 * properties.youngsEff);
+    properties.tangentialDampingFactor = dampingPrefactor * std::sqrt(8.0 * properties.shearEff);
     return properties;
 }
 

@@ -397,13 +397,16 @@ void Simulation::computeForces() {
 
 void Simulation::step(long steps) {
     const double dt = settings_.timeStep;
+    // Within one call the closing half kick of a step and the opening half kick
+    // and drift of the next are one pass over the particles (same arithmetic).
+    bool drifted = false;
     for (long s = 0; s < steps; ++s) {
         if (!forcesValid_) {
             updatePairList();
             computeForces();
             forcesValid_ = true;
         }
-        kickAndDrift(particles_, dt, ownedCount());
+        if (!drifted) kickAndDrift(particles_, dt, ownedCount());
         ++step_;
         // Time from the step count: no drift from summing dt, exact on restart.
         time_ = step_ * dt;
@@ -416,7 +419,11 @@ void Simulation::step(long steps) {
         }
         if (rebuild) updatePairList();
         computeForces();
-        kick(particles_, dt, ownedCount());
+        drifted = s + 1 < steps;
+        if (drifted)
+            kickKickAndDrift(particles_, dt, ownedCount());
+        else
+            kick(particles_, dt, ownedCount());
     }
 }
 

@@ -32,16 +32,18 @@ inline constexpr double kSqrtFiveSixths = 0.91287092917527685576;
 DEM_ALWAYS_INLINE HertzNormal hertzNormal(double overlap, double normalVelocity, double radiusEff,
                                double massEff, const InteractionProperties& properties,
                                bool limitForce, bool tangentialDamping) noexcept {
+    // Two square roots: a = sqrt(R* d) and sqrt(a m*).  The constant factors
+    // (4/3 Y*, 8 G*, -2 sqrt(5/6) beta sqrt(2 Y*), -2 sqrt(5/6) beta sqrt(8 G*))
+    // are taken from the material pair, so sqrt(Sn m*) = sqrt(2 Y*) sqrt(a m*)
+    // and sqrt(St m*) = sqrt(8 G*) sqrt(a m*) need no root of their own.
     const double contactScale = std::sqrt(radiusEff * overlap);  // sqrt(R* d) = contact radius
-    const double sn = 2.0 * properties.youngsEff * contactScale;
-    const double st = 8.0 * properties.shearEff * contactScale;
+    const double dampingScale = std::sqrt(contactScale * massEff);
 
     HertzNormal result;
-    result.normalStiffness = 4.0 / 3.0 * properties.youngsEff * contactScale;
-    result.tangentialStiffness = st;
-    result.normalDamping = -2.0 * kSqrtFiveSixths * properties.beta * std::sqrt(sn * massEff);
-    result.tangentialDamping =
-        tangentialDamping ? -2.0 * kSqrtFiveSixths * properties.beta * std::sqrt(st * massEff) : 0.0;
+    result.normalStiffness = properties.normalStiffnessFactor * contactScale;
+    result.tangentialStiffness = properties.tangentialStiffnessFactor * contactScale;
+    result.normalDamping = properties.normalDampingFactor * dampingScale;
+    result.tangentialDamping = tangentialDamping ? properties.tangentialDampingFactor * dampingScale : 0.0;
     result.elasticForce = result.normalStiffness * overlap;
     const double force = result.elasticForce - result.normalDamping * normalVelocity;
     result.force = (limitForce && force < 0.0) ? 0.0 : force;

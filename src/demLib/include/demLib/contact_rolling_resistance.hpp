@@ -58,9 +58,10 @@ DEM_ALWAYS_INLINE Vec3 elasticPlasticRollingTorque(Vec3& springTorque, const Vec
                                         double viscousCoefficient) noexcept {
     const Vec3 omegaTangential = omega - omega.dot(normal) * normal;
     springTorque -= (rollingStiffness * dt) * omegaTangential;
-    const double springMagnitude = springTorque.norm();
-    if (springMagnitude > torqueLimit) {
-        springTorque *= torqueLimit / springMagnitude;
+    // |M| > Mmax in squared form (both >= 0): the root only when the limit is reached.
+    const double springMagnitudeSquared = springTorque.squaredNorm();
+    if (springMagnitudeSquared > torqueLimit * torqueLimit) {
+        springTorque *= torqueLimit / std::sqrt(springMagnitudeSquared);
         return springTorque;
     }
     return springTorque - viscousCoefficient * omegaTangential;

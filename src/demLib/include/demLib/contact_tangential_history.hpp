@@ -24,16 +24,15 @@ DEM_ALWAYS_INLINE Vec3 tangentialHistoryForce(Vec3& shear, const Vec3& normal, c
     shear += tangentialVelocity * dt;
     shear -= shear.dot(normal) * normal;
 
-    const double shearLength = shear.norm();
+    // The Coulomb test kt|s| > mu|Fn| in squared form (both sides are >= 0):
+    // the square root and the division are needed only when the contact slides.
+    const double shearLengthSquared = shear.squaredNorm();
     Vec3 force = -tangentialStiffness * shear;
-    const double elasticMagnitude = tangentialStiffness * shearLength;
-    if (elasticMagnitude > frictionLimit) {
-        if (shearLength != 0.0) {
-            force *= frictionLimit / elasticMagnitude;
-            shear = -force / tangentialStiffness;
-        } else {
-            force.setZero();
-        }
+    if (tangentialStiffness * tangentialStiffness * shearLengthSquared > frictionLimit * frictionLimit) {
+        // |s| > 0 here.  Ft = -kt s mu|Fn| / (kt|s|) and s = -Ft/kt = s mu|Fn| / (kt|s|).
+        const double scale = frictionLimit / (tangentialStiffness * std::sqrt(shearLengthSquared));
+        force *= scale;
+        shear *= scale;
     } else {
         force -= tangentialDamping * tangentialVelocity;
     }

@@ -13,4 +13,9 @@ void kickAndDrift(ParticleStore& particles, double dt, std::size_t count = stati
 // v += dt/2 F/m, ω += dt/2 T/I, for particles 0 .. count-1.
 void kick(ParticleStore& particles, double dt, std::size_t count = static_cast<std::size_t>(-1));
 
+// kick() of one step followed by kickAndDrift() of the next, in one pass over
+// the particles (the forces do not change in between): the same operations in
+// the same order per particle, so the same results as the two calls.
+void kickKickAndDrift(ParticleStore& particles, double dt, std::size_t count = static_cast<std::size_t>(-1));
+
 }  // namespace dem

@@ -33,6 +33,15 @@ struct InteractionProperties {
     double friction = 0.0;
     double rollingFriction = 0.0;
     double rollingViscousDamping = 0.0;
+    // Derived once per material pair by makeInteraction (and only there), so
+    // that a contact evaluates the Hertz coefficients from a = sqrt(R* d) and
+    // sqrt(a m*) with two square roots instead of four (docs/contact-models.md):
+    //   kn = normalStiffnessFactor a,  kt = tangentialStiffnessFactor a,
+    //   gn = normalDampingFactor sqrt(a m*),  gt = tangentialDampingFactor sqrt(a m*).
+    double normalStiffnessFactor = 0.0;      // 4/3 Y*                         [Pa]
+    double tangentialStiffnessFactor = 0.0;  // 8 G*                           [Pa]
+    double normalDampingFactor = 0.0;        // -2 sqrt(5/6) beta sqrt(2 Y*)   [Pa^0.5]
+    double tangentialDampingFactor = 0.0;    // -2 sqrt(5/6) beta sqrt(8 G*)   [Pa^0.5]
 };
 
 // Throws InputError unless E > 0, 0 <= nu <= 0.5 and density > 0.
