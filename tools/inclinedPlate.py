@@ -104,6 +104,7 @@ def main():
             plots.side_view(os.path.join(out, f"sideView_{name}.png"), f, (1, 0, 0), (0, 0, 1), color_by="omega",
                             title=f"t = {tt:.3f} s, plate at {pose.rotation_angle(tt):.1f}°, {f.count} particles")
 
+    monotone_tolerance = 2.0 * float(np.mean(ref.mass)) / m0
     res = {
         "setting": setting,
         "rollingModel": rolling,
@@ -115,7 +116,11 @@ def main():
         "slidFractionAt27deg": {"value": float(np.interp(27.0, angle, slid)), "unit": "-", "description": "experiment: about 0.35"},
         "finalAngle": {"value": float(angle[-1]), "unit": "deg"},
         "finalSlidFraction": {"value": float(slid[-1]), "unit": "-"},
-        "slidFractionMonotone": {"value": plate.is_monotone_non_decreasing(slid, 1e-9), "unit": "-"},
+        # A grain knocked off the plate's footprint or above its layer can land back on the plate
+        # (seen in the quick setting at 9-12 deg: one particle of 666), so the curve may dip by a
+        # grain or two; mass coming back beyond that would mean the measure is wrong.
+        "slidFractionMonotone": {"value": plate.is_monotone_non_decreasing(slid, monotone_tolerance), "unit": "-",
+                                 "description": f"never decreases by more than the mass of 2 mean particles ({monotone_tolerance:.4f} of the mass)"},
         "lostCount": {"value": int(s["lostCount"][-1]), "unit": "-", "description": "particles that fell off the plate out of the domain (by design)"},
         "lostMass": {"value": float(s["lostMass"][-1]) * 1e3, "unit": "g"},
         "finalKineticEnergy": {"value": float(s["kineticEnergy"][-1]), "unit": "J"},
