@@ -19,32 +19,13 @@ struct InverseMass {
         mass = armSquared * inertia;
     }
 };
-}  // namespace
 
-void kickAndDrift(ParticleStore& p, double dt, std::size_t count) {
-    const double half = 0.5 * dt;
-    const std::size_t n = std::min(count, p.size());
-#pragma omp parallel for schedule(static) num_threads(threadsFor(n, lightLoopParticlesPerThread))
-    for (std::size_t i = 0; i < n; ++i) {
-        const InverseMass inv(p.mass[i], p.radius[i]);
-        p.velocity[i] += (half * inv.mass) * p.force[i];
-        p.omega[i] += (half * inv.inertia) * p.torque[i];
-        p.position[i] += dt * p.velocity[i];
-    }
-}
-
-void kick(ParticleStore& p, double dt, std::size_t count) {
-    const double half = 0.5 * dt;
-    const std::size_t n = std::min(count, p.size());
-#pragma omp parallel for schedule(static) num_threads(threadsFor(n, lightLoopParticlesPerThread))
-    for (std::size_t i = 0; i < n; ++i) {
-        const InverseMass inv(p.mass[i], p.radius[i]);
-        p.velocity[i] += (half * inv.mass) * p.force[i];
-        p.omega[i] += (half * inv.inertia) * p.torque[i];
-    }
-}
-
-void kickKickAndDrift(ParticleStore& p, double dt, std::size_t count) {
+// The one loop behind the three entry points: `kicks` half kicks with the
+// same force and torque (two = the closing kick of a step and the opening
+// kick of the next), then the drift if asked.  Each half kick is its own
+// addition, so kicks = 2 rounds exactly like two separate calls.
+template <int kicks, bool drift>
+void advance(ParticleStore& p, double dt, std::size_t count) {
     const double half = 0.5 * dt;
     const std::size_t n = std::min(count, p.size());
 #pragma omp parallel for schedule(static) num_threads(threadsFor(n, lightLoopParticlesPerThread))
@@ -52,12 +33,19 @@ void kickKickAndDrift(ParticleStore& p, double dt, std::size_t count) {
         const InverseMass inv(p.mass[i], p.radius[i]);
         const Vec3 dv = (half * inv.mass) * p.force[i];
         const Vec3 dw = (half * inv.inertia) * p.torque[i];
-        p.velocity[i] += dv;  // end of this step
-        p.omega[i] += dw;
-        p.velocity[i] += dv;  // start of the next
-        p.omega[i] += dw;
-        p.position[i] += dt * p.velocity[i];
+        for (int k = 0; k < kicks; ++k) {
+            p.velocity[i] += dv;
+            p.omega[i] += dw;
+        }
+        if constexpr (drift) p.position[i] += dt * p.velocity[i];
     }
 }
+}  // namespace
+
+void kickAndDrift(ParticleStore& p, double dt, std::size_t count) { advance<1, true>(p, dt, count); }
+
+void kick(ParticleStore& p, double dt, std::size_t count) { advance<1, false>(p, dt, count); }
+
+void kickKickAndDrift(ParticleStore& p, double dt, std::size_t count) { advance<2, true>(p, dt, count); }
 
 }  // namespace dem
