@@ -48,19 +48,7 @@ def main():
     window = tuple(np.asarray(a.window) * 1e-3) if a.window else profile.flank_window(r, h, *a.heights)
     fit = profile.fit_line(r, h, window)
     # the same fit sector by sector: the spread around the axis
-    sector_angles = []
-    for k in range(a.sectors):
-        x = f.position - axis_point
-        e = axis
-        rv = x - np.outer(x @ e, e)
-        u = geometry.unit(np.cross(e, [1, 0, 0]) if abs(e[0]) < 0.9 else np.cross(e, [0, 1, 0]))
-        phi = np.arctan2(rv @ np.cross(e, u), rv @ u)
-        sel = np.minimum(((phi + np.pi) / (2 * np.pi) * a.sectors).astype(int), a.sectors - 1) == k
-        rs, hs, _ = profile.radial_profile(f.position[sel], f.radius[sel], axis_point, axis, bw, sectors=1)
-        try:
-            sector_angles.append(profile.fit_line(rs, hs, window)["angle"])
-        except ValueError:
-            pass
+    sector_angles = profile.sector_angles(f.position, f.radius, axis_point, axis, bw, window, a.sectors)
     removed_at = float(tube.get("removeAt", np.inf))
     s = summary.read(case)
     setting = open(os.path.join(case, "constant", "setting")).read().strip() \

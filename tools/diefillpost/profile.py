@@ -16,6 +16,15 @@ def _binned_max(coord, top, edges, groups=None, n_groups=1):
     return out
 
 
+def _sector_of(rvec, e, sectors):
+    """Azimuthal sector (0 .. sectors-1) of radial vectors `rvec` around the unit axis `e`."""
+    # an in-plane basis for the azimuth
+    u = unit(np.cross(e, [1, 0, 0]) if abs(e[0]) < 0.9 else np.cross(e, [0, 1, 0]))
+    v = np.cross(e, u)
+    phi = np.arctan2(rvec @ v, rvec @ u)
+    return np.minimum(((phi + np.pi) / (2 * np.pi) * sectors).astype(int), sectors - 1)
+
+
 def radial_profile(position, radius, axis_point=(0, 0, 0), axis=(0, 0, 1), bin_width=1e-3,
                    r_max=None, sectors=8, base=0.0):
     """Surface height vs distance from an axis, averaged around it.
@@ -29,11 +38,7 @@ def radial_profile(position, radius, axis_point=(0, 0, 0), axis=(0, 0, 1), bin_w
     z = x @ e
     rvec = x - np.outer(z, e)
     rho = np.linalg.norm(rvec, axis=1)
-    # an in-plane basis for the azimuth
-    u = unit(np.cross(e, [1, 0, 0]) if abs(e[0]) < 0.9 else np.cross(e, [0, 1, 0]))
-    v = np.cross(e, u)
-    phi = np.arctan2(rvec @ v, rvec @ u)
-    sector = np.minimum(((phi + np.pi) / (2 * np.pi) * sectors).astype(int), sectors - 1)
+    sector = _sector_of(rvec, e, sectors)
     r_max = float(np.max(rho)) + bin_width if r_max is None else r_max
     edges = np.arange(0.0, r_max + 0.5 * bin_width, bin_width)
     per_sector = _binned_max(rho, z + np.asarray(radius, float) - base, edges, sector, sectors)
@@ -41,6 +46,26 @@ def radial_profile(position, radius, axis_point=(0, 0, 0), axis=(0, 0, 1), bin_w
     with np.errstate(invalid="ignore"):
         h = np.where(n > 0, np.nansum(np.nan_to_num(per_sector, nan=0.0), axis=0) / np.maximum(n, 1), np.nan)
     return 0.5 * (edges[1:] + edges[:-1]), h, n
+
+
+def sector_angles(position, radius, axis_point, axis, bin_width, window, sectors=8):
+    """The pile's angle sector by sector: in each of `sectors` azimuthal sectors the
+    profile of that sector's particles alone (radial_profile with one sector) fitted
+    over `window` (fit_line); sectors with fewer than 3 points in the window are left
+    out.  Returns the list of angles (deg), whose spread shows how round the pile is."""
+    position, radius = np.asarray(position, float), np.asarray(radius, float)
+    x = position - np.asarray(axis_point, float)
+    e = unit(axis)
+    sector = _sector_of(x - np.outer(x @ e, e), e, sectors)
+    angles = []
+    for k in range(sectors):
+        sel = sector == k
+        r, h, _ = radial_profile(position[sel], radius[sel], axis_point, axis, bin_width, sectors=1)
+        try:
+            angles.append(fit_line(r, h, window)["angle"])
+        except ValueError:
+            pass
+    return angles
 
 
 def line_profile(position, radius, origin=(0, 0, 0), direction=(1, 0, 0), up=(0, 0, 1), bin_width=1e-3,
