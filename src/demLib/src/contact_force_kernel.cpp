@@ -1,5 +1,7 @@
 #include "demLib/contact_force_kernel.hpp"
 
+#include "demLib/contact_law_batch.hpp"
+
 #include "demLib/parallel.hpp"
 
 #include <algorithm>
@@ -54,6 +56,7 @@ public:
         std::vector<ContactStatistics> stats(threads);
         changes_.resize(threads);
         for (auto& c : changes_) c.clear();
+        while (static_cast<int>(batches_.size()) < threads) batches_.push_back(std::make_unique<ContactBatch>());
         newWall_.resize(threads);
         for (auto& w : newWall_) w.clear();
         auto& newWall = newWall_;
@@ -75,7 +78,11 @@ public:
             Vec3* torque = t == 0 ? p.torque.data() : buffers_[t].torque.data();
             const int begin = rowSplit(t);
             const int end = rowSplit(t + 1);
-            pairForces(p, pairs, interactions, dt, begin, end, force, torque, stats[t], changes_[t]);
+            if constexpr (Cohesion == CohesionModel::None)
+                pairForcesBatched(p, pairs, interactions, dt, begin, end, force, torque, stats[t], changes_[t],
+                                  *batches_[t]);
+            else
+                pairForces(p, pairs, interactions, dt, begin, end, force, torque, stats[t], changes_[t]);
             wallForces(p, wallContacts, walls, wallCandidates, interactions, time, dt, begin, end, force,
                        torque, newWall[t], stats[t]);
             if (threads > 1) {
@@ -120,6 +127,7 @@ private:
     };
     std::vector<Buffer> buffers_;
     std::vector<ContactHistoryPool::Changes> changes_;  // per thread, reused
+    std::vector<std::unique_ptr<ContactBatch>> batches_;  // per thread, reused (32 kB each)
     std::vector<std::vector<WallContactRecord>> newWall_;  // per thread, reused
 
     void pairForces(ParticleStore& p, ParticleParticleNeighborList& pairs,
@@ -231,6 +239,136 @@ private:
             }
             force[i] += fi;
             torque[i] += ti;
+        }
+        stats.touchingPairs += touchingPairs;
+    }
+
+    // pairForces without cohesion, in three passes over batches of touching
+    // pairs: the touching test (pairs that opened forget their springs) gathers
+    // the touching pairs' inputs into a ContactBatch; evaluateContactBatch runs
+    // the law over the batch in vector lanes; the forces and torques are added
+    // in list order.  A row may span batches (its sums are carried over).  The
+    // results are bitwise those of pairForces (same operations, same sums).
+    void pairForcesBatched(ParticleStore& p, ParticleParticleNeighborList& pairs,
+                           const InteractionTable& interactions, double dt, int begin, int end, Vec3* force,
+                           Vec3* torque, ContactStatistics& stats, ContactHistoryPool::Changes& changes,
+                           ContactBatch& b) const {
+        constexpr bool keepsRolling = Rolling == RollingModel::EPSD || Rolling == RollingModel::EPSD2;
+        constexpr int capacity = ContactBatch::capacity;
+        const int* offsets = pairs.offsets().data();
+        const int* neighbors = pairs.neighbors().data();
+        ContactHistoryPool& pool = pairs.history();
+        int* slot = pool.slots();
+        double* records = pool.record(0);  // slots are only handed out after the loop
+        const std::size_t stride = pool.stride();
+        std::size_t touchingPairs = 0;
+        int row = begin;                      // pass 1's cursor: row and list entry
+        int k = begin < end ? offsets[begin] : 0;
+        int sumRow = begin;                   // pass 3's cursor and the sums of its row
+        Vec3 fi = Vec3::Zero();
+        Vec3 ti = Vec3::Zero();
+        while (row < end) {
+            // Pass 1.
+            int count = 0;
+            for (; row < end; ++row) {
+                const Vec3 xi = p.position[row];
+                const double ri = p.radius[row];
+                const int rowEnd = offsets[row + 1];
+                for (; k < rowEnd && count < capacity; ++k) {
+                    const int j = neighbors[k];
+                    const Vec3 d = xi - p.position[j];
+                    const double rj = p.radius[j];
+                    const double radiusSum = ri + rj;
+                    const double dist2 = d.squaredNorm();
+                    if (dist2 >= radiusSum * radiusSum) {
+                        // A contact that opens forgets its springs (LIGGGHTS surfacesClose).
+                        if (slot[k] >= 0) {
+                            changes.released.push_back(slot[k]);
+                            slot[k] = -1;
+                        }
+                        continue;
+                    }
+                    const int e = count++;
+                    b.entry[e] = k;
+                    b.particleI[e] = row;
+                    b.particleJ[e] = j;
+                    b.properties[e] = &interactions(p.material[row], p.material[j]);
+                    b.dx[e] = d.x();
+                    b.dy[e] = d.y();
+                    b.dz[e] = d.z();
+                    b.distanceSquared[e] = dist2;
+                    b.radiusI[e] = ri;
+                    b.radiusJ[e] = rj;
+                    b.massI[e] = p.mass[row];
+                    b.massJ[e] = p.mass[j];
+                    const Vec3 dv = p.velocity[row] - p.velocity[j];
+                    b.dvx[e] = dv.x();
+                    b.dvy[e] = dv.y();
+                    b.dvz[e] = dv.z();
+                    const Vec3& wi = p.omega[row];
+                    const Vec3& wj = p.omega[j];
+                    b.wix[e] = wi.x();
+                    b.wiy[e] = wi.y();
+                    b.wiz[e] = wi.z();
+                    b.wjx[e] = wj.x();
+                    b.wjy[e] = wj.y();
+                    b.wjz[e] = wj.z();
+                    // A contact without a slot is new: its springs start from zero.
+                    const int s = slot[k];
+                    const double* record = s >= 0 ? records + s * stride : nullptr;
+                    b.sx[e] = record ? record[0] : 0.0;
+                    b.sy[e] = record ? record[1] : 0.0;
+                    b.sz[e] = record ? record[2] : 0.0;
+                    if constexpr (keepsRolling) {
+                        b.mx[e] = record ? record[3] : 0.0;
+                        b.my[e] = record ? record[4] : 0.0;
+                        b.mz[e] = record ? record[5] : 0.0;
+                    }
+                }
+                if (k < rowEnd) break;  // batch full inside this row
+                if (row + 1 < end) k = offsets[row + 1];
+            }
+            touchingPairs += count;
+
+            // Pass 2: the law in vector lanes.
+            if (count > 0) evaluateContactBatch<Rolling>(b, count, dt);
+
+            // Pass 3: sums in list order; every row before pass 1's cursor is complete.
+            auto closeRow = [&]() {
+                force[sumRow] += fi;
+                torque[sumRow] += ti;
+                fi.setZero();
+                ti.setZero();
+                ++sumRow;
+            };
+            for (int e = 0; e < count; ++e) {
+                while (sumRow < b.particleI[e]) closeRow();
+                const int j = b.particleJ[e];
+                const Vec3 f(b.fx[e], b.fy[e], b.fz[e]);
+                fi += f;
+                force[j] -= f;
+                ti += Vec3(b.tix[e], b.tiy[e], b.tiz[e]);
+                torque[j] += Vec3(b.tjx[e], b.tjy[e], b.tjz[e]);
+                // History back to its record, or to the pool's new records after the loop.
+                const int s = slot[b.entry[e]];
+                if (s >= 0) {
+                    double* record = records + s * stride;
+                    record[0] = b.sx[e];
+                    record[1] = b.sy[e];
+                    record[2] = b.sz[e];
+                    if constexpr (keepsRolling) {
+                        record[3] = b.mx[e];
+                        record[4] = b.my[e];
+                        record[5] = b.mz[e];
+                    }
+                } else {
+                    ContactHistory history;
+                    history.shear = Vec3(b.sx[e], b.sy[e], b.sz[e]);
+                    if constexpr (keepsRolling) history.rollingTorque = Vec3(b.mx[e], b.my[e], b.mz[e]);
+                    changes.opened.push_back({b.entry[e], history});
+                }
+            }
+            while (sumRow < row) closeRow();
         }
         stats.touchingPairs += touchingPairs;
     }
