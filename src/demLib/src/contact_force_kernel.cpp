@@ -78,7 +78,7 @@ public:
             Vec3* torque = t == 0 ? p.torque.data() : buffers_[t].torque.data();
             const int begin = rowSplit(t);
             const int end = rowSplit(t + 1);
-            if constexpr (Cohesion == CohesionModel::None)
+            if (settings_.vectorizedPairLaw)
                 pairForcesBatched(p, pairs, interactions, dt, begin, end, force, torque, stats[t], changes_[t],
                                   *batches_[t]);
             else
@@ -127,9 +127,11 @@ private:
     };
     std::vector<Buffer> buffers_;
     std::vector<ContactHistoryPool::Changes> changes_;  // per thread, reused
-    std::vector<std::unique_ptr<ContactBatch>> batches_;  // per thread, reused (32 kB each)
+    std::vector<std::unique_ptr<ContactBatch>> batches_;  // per thread, reused (45 kB each)
     std::vector<std::vector<WallContactRecord>> newWall_;  // per thread, reused
 
+    // The scalar pair loop (settings_.vectorizedPairLaw = false): one contact
+    // after the other through ContactLaw::evaluate; the reference of pairForcesBatched.
     void pairForces(ParticleStore& p, ParticleParticleNeighborList& pairs,
                     const InteractionTable& interactions, double dt, int begin, int end, Vec3* force,
                     Vec3* torque, ContactStatistics& stats, ContactHistoryPool::Changes& changes) const {
@@ -243,9 +245,10 @@ private:
         stats.touchingPairs += touchingPairs;
     }
 
-    // pairForces without cohesion, in three passes over batches of touching
-    // pairs: the touching test (pairs that opened forget their springs) gathers
-    // the touching pairs' inputs into a ContactBatch; evaluateContactBatch runs
+    // pairForces in three passes over batches of touching pairs (and, with
+    // cohesion, of bridges beyond contact): the touching test (pairs that opened
+    // forget their springs; bridges are updated as in pairForces) gathers the
+    // pairs' inputs into a ContactBatch; evaluateContactBatch runs
     // the law over the batch in vector lanes; the forces and torques are added
     // in list order.  A row may span batches (its sums are carried over).  The
     // results are bitwise those of pairForces (same operations, same sums).
@@ -261,6 +264,7 @@ private:
         int* slot = pool.slots();
         double* records = pool.record(0);  // slots are only handed out after the loop
         const std::size_t stride = pool.stride();
+        double* bridge = Cohesion == CohesionModel::Capillary ? pairs.bridgeVolume().data() : nullptr;
         std::size_t touchingPairs = 0;
         int row = begin;                      // pass 1's cursor: row and list entry
         int k = begin < end ? offsets[begin] : 0;
@@ -280,15 +284,48 @@ private:
                     const double rj = p.radius[j];
                     const double radiusSum = ri + rj;
                     const double dist2 = d.squaredNorm();
-                    if (dist2 >= radiusSum * radiusSum) {
-                        // A contact that opens forgets its springs (LIGGGHTS surfacesClose).
+                    // A contact that opens forgets its springs (LIGGGHTS surfacesClose).
+                    auto forget = [&]() {
                         if (slot[k] >= 0) {
                             changes.released.push_back(slot[k]);
                             slot[k] = -1;
                         }
-                        continue;
+                    };
+                    double cohesiveForce = 0.0;
+                    bool touching = true;
+                    if constexpr (Cohesion == CohesionModel::None) {
+                        if (dist2 >= radiusSum * radiusSum) {
+                            forget();
+                            continue;
+                        }
+                    } else {
+                        // The bridge needs the gap of every listed pair (the lanes
+                        // compute the same root and normal again).
+                        const double overlap = radiusSum - std::sqrt(dist2);
+                        double& volume = bridge[k];
+                        if (volume > 0.0) {
+                            const double gap = -overlap;
+                            if (gap > debondingDistance(volume, settings_.capillary.contactAngle)) {
+                                stats.releasedLiquid += volume;  // back to the free liquid
+                                volume = 0.0;
+                            } else {
+                                cohesiveForce = settings_.capillaryForceScale *
+                                                capillaryForce(ri, rj, gap, volume, settings_.capillary);
+                                ++stats.bridges;
+                            }
+                        }
+                        if (overlap <= 0.0) {
+                            forget();
+                            if (cohesiveForce == 0.0) continue;
+                            touching = false;  // a bridge beyond contact: a force entry only
+                        }
                     }
+                    touchingPairs += touching;
                     const int e = count++;
+                    if constexpr (Cohesion == CohesionModel::Capillary) {
+                        b.extraNormalForce[e] = cohesiveForce;
+                        b.touching[e] = touching ? 1.0 : 0.0;
+                    }
                     b.entry[e] = k;
                     b.particleI[e] = row;
                     b.particleJ[e] = j;
@@ -328,10 +365,8 @@ private:
                 if (k < rowEnd) break;  // batch full inside this row
                 if (row + 1 < end) k = offsets[row + 1];
             }
-            touchingPairs += count;
-
             // Pass 2: the law in vector lanes.
-            if (count > 0) evaluateContactBatch<Rolling>(b, count, dt);
+            if (count > 0) evaluateContactBatch<Rolling, Cohesion == CohesionModel::Capillary>(b, count, dt);
 
             // Pass 3: sums in list order; every row before pass 1's cursor is complete.
             auto closeRow = [&]() {
@@ -347,6 +382,9 @@ private:
                 const Vec3 f(b.fx[e], b.fy[e], b.fz[e]);
                 fi += f;
                 force[j] -= f;
+                if constexpr (Cohesion == CohesionModel::Capillary) {
+                    if (b.touching[e] == 0.0) continue;  // a bridge beyond contact: no torque, no history
+                }
                 ti += Vec3(b.tix[e], b.tiy[e], b.tiz[e]);
                 torque[j] += Vec3(b.tjx[e], b.tjy[e], b.tjz[e]);
                 // History back to its record, or to the pool's new records after the loop.

@@ -16,7 +16,7 @@ struct PairConstants {
 // (contact_force_kernel.cpp), written lane by lane with the same operations in
 // the same order.  The comments name the scalar expression each line mirrors.
 
-template <RollingModel Rolling, bool Uniform>
+template <RollingModel Rolling, bool Cohesive, bool Uniform>
 DEM_ALWAYS_INLINE void evaluateBatchBody(ContactBatch& b, int count, double dt, const PairConstants<Uniform>& c) {
     using Settings = LiggghtsDefaultContactSettings;
     static_assert(!Settings::limitForce && Settings::tangentialDamping && !Settings::cohesionInFrictionLimits,
@@ -31,6 +31,8 @@ DEM_ALWAYS_INLINE void evaluateBatchBody(ContactBatch& b, int count, double dt, 
     const double* __restrict etaRLane = c.etaR;
     const double kn0 = c.kn[0], kt0 = c.kt[0], gn0 = c.gn[0], gt0 = c.gt[0], mu0 = c.mu[0], muR0 = c.muR[0],
                  etaR0 = c.etaR[0];
+    const double* __restrict extra = b.extraNormalForce;
+    const double* __restrict touching = b.touching;
     const double* __restrict dx = b.dx;
     const double* __restrict dy = b.dy;
     const double* __restrict dz = b.dz;
@@ -100,7 +102,7 @@ DEM_ALWAYS_INLINE void evaluateBatchBody(ContactBatch& b, int count, double dt, 
         const double gt = (Uniform ? gt0 : gtLane[e]) * dampingScale;
         const double elasticForce = kn * overlap;
         const double hertzForce = elasticForce - gn * normalVelocity;
-        const double normalForce = hertzForce + 0.0;  // + extraNormalForce (none here)
+        const double normalForce = hertzForce + (Cohesive ? extra[e] : 0.0);  // + extraNormalForce
         const double limitingNormalForce = std::abs(hertzForce);
 
         // --- tangential: tangentialHistoryForce ---
@@ -171,6 +173,14 @@ DEM_ALWAYS_INLINE void evaluateBatchBody(ContactBatch& b, int count, double dt, 
         fxs[e] = normalForce * nx + ftx;
         fys[e] = normalForce * ny + fty;
         fzs[e] = normalForce * nz + ftz;
+        if constexpr (Cohesive) {
+            // A bridge beyond contact pulls along the normal only (the law's
+            // lanes hold NaN from the negative overlap and are dropped).
+            const bool contact = touching[e] != 0.0;
+            fxs[e] = contact ? fxs[e] : extra[e] * nx;
+            fys[e] = contact ? fys[e] : extra[e] * ny;
+            fzs[e] = contact ? fzs[e] : extra[e] * nz;
+        }
         const double cx = ny * ftz - nz * fty;  // n x Ft
         const double cy = nz * ftx - nx * ftz;
         const double cz = nx * fty - ny * ftx;
@@ -192,7 +202,7 @@ DEM_ALWAYS_INLINE void evaluateBatchBody(ContactBatch& b, int count, double dt, 
 #define DEM_VECTOR_CLONES
 #endif
 
-template <RollingModel Rolling>
+template <RollingModel Rolling, bool Cohesive>
 DEM_VECTOR_CLONES void evaluateContactBatch(ContactBatch& batch, int count, double dt) {
     const InteractionProperties* first = batch.properties[0];
     bool uniform = true;
@@ -202,7 +212,7 @@ DEM_VECTOR_CLONES void evaluateContactBatch(ContactBatch& batch, int count, doub
                                     &first->normalDampingFactor,   &first->tangentialDampingFactor,
                                     &first->friction,              &first->rollingFriction,
                                     &first->rollingViscousDamping};
-        evaluateBatchBody<Rolling, true>(batch, count, dt, c);
+        evaluateBatchBody<Rolling, Cohesive, true>(batch, count, dt, c);
         return;
     }
     for (int e = 0; e < count; ++e) {
@@ -219,12 +229,16 @@ DEM_VECTOR_CLONES void evaluateContactBatch(ContactBatch& batch, int count, doub
                                  batch.normalDampingFactor,   batch.tangentialDampingFactor,
                                  batch.friction,              batch.rollingFriction,
                                  batch.rollingViscousDamping};
-    evaluateBatchBody<Rolling, false>(batch, count, dt, c);
+    evaluateBatchBody<Rolling, Cohesive, false>(batch, count, dt, c);
 }
 
-template void evaluateContactBatch<RollingModel::None>(ContactBatch&, int, double);
-template void evaluateContactBatch<RollingModel::CDT>(ContactBatch&, int, double);
-template void evaluateContactBatch<RollingModel::EPSD>(ContactBatch&, int, double);
-template void evaluateContactBatch<RollingModel::EPSD2>(ContactBatch&, int, double);
+template void evaluateContactBatch<RollingModel::None, false>(ContactBatch&, int, double);
+template void evaluateContactBatch<RollingModel::None, true>(ContactBatch&, int, double);
+template void evaluateContactBatch<RollingModel::CDT, false>(ContactBatch&, int, double);
+template void evaluateContactBatch<RollingModel::CDT, true>(ContactBatch&, int, double);
+template void evaluateContactBatch<RollingModel::EPSD, false>(ContactBatch&, int, double);
+template void evaluateContactBatch<RollingModel::EPSD, true>(ContactBatch&, int, double);
+template void evaluateContactBatch<RollingModel::EPSD2, false>(ContactBatch&, int, double);
+template void evaluateContactBatch<RollingModel::EPSD2, true>(ContactBatch&, int, double);
 
 }  // namespace dem

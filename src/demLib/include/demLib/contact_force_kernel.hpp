@@ -29,6 +29,10 @@ struct ForceFieldSettings {
     // Particle-wall liquid bridges (capillaryForceSphereWall); walls are then
     // searched out to ParticleWallContacts::bridgeReach() beyond contact.
     bool wallBridges = false;
+    // Pair contacts evaluated in batches in vector lanes (contact_law_batch.hpp).
+    // false runs the scalar loop instead: the reference the batched loop is
+    // tested against; both give bitwise the same results.
+    bool vectorizedPairLaw = true;
 };
 
 struct ContactStatistics {

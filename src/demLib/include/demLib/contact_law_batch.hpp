@@ -32,6 +32,10 @@ struct ContactBatch {
     alignas(64) double radiusI[capacity], radiusJ[capacity], massI[capacity], massJ[capacity];
     alignas(64) double dvx[capacity], dvy[capacity], dvz[capacity];
     alignas(64) double wix[capacity], wiy[capacity], wiz[capacity], wjx[capacity], wjy[capacity], wjz[capacity];
+    // with cohesion only: the cohesive normal force (ContactLaw's extraNormalForce),
+    // and 1 for a touching pair, 0 for a bridge beyond contact (force = cohesive
+    // force along the normal, no torque, no history)
+    alignas(64) double extraNormalForce[capacity], touching[capacity];
     // history, read and written: shear displacement, EPSD/EPSD2 spring torque
     alignas(64) double sx[capacity], sy[capacity], sz[capacity], mx[capacity], my[capacity], mz[capacity];
     // outputs: total force on i (j gets the opposite), torques on i and on j
@@ -43,9 +47,10 @@ struct ContactBatch {
     alignas(64) double friction[capacity], rollingFriction[capacity], rollingViscousDamping[capacity];
 };
 
-// Evaluates entries [0, count) of the batch, count <= capacity.  Each entry must
-// touch (distanceSquared < (radiusI + radiusJ)^2).
-template <RollingModel Rolling>
+// Evaluates entries [0, count) of the batch, count <= capacity.  Without
+// cohesion every entry must touch (distanceSquared < (radiusI + radiusJ)^2) and
+// extraNormalForce and touching are not read.
+template <RollingModel Rolling, bool Cohesive>
 void evaluateContactBatch(ContactBatch& batch, int count, double dt);
 
 }  // namespace dem
