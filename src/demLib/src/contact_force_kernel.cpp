@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -22,6 +23,43 @@ int threadIndex() {
     return 0;
 #endif
 }
+
+// Where one thread's pair loop adds forces and torques: straight into the
+// particle arrays for the particles of its own rows [begin, end), which no other
+// thread writes during the loop, and into the thread's own buffer for the
+// others (neighbours just beyond its block), added by their owners afterwards.
+struct ForceSink {
+    Vec3* force;
+    Vec3* torque;
+    Vec3* bufferedForce;   // null with one thread
+    Vec3* bufferedTorque;
+    int begin, end;
+    int lowestBuffered = std::numeric_limits<int>::max();
+    int highestBuffered = -1;
+
+    DEM_ALWAYS_INLINE bool owns(int j) const noexcept { return j >= begin && j < end; }
+    // force[j] -= f and torque[j] += t, here or in the buffer.
+    DEM_ALWAYS_INLINE void onOther(int j, const Vec3& f, const Vec3& t) noexcept {
+        if (owns(j)) {
+            force[j] -= f;
+            torque[j] += t;
+        } else {
+            bufferedForce[j] -= f;
+            bufferedTorque[j] += t;
+            lowestBuffered = std::min(lowestBuffered, j);
+            highestBuffered = std::max(highestBuffered, j);
+        }
+    }
+    DEM_ALWAYS_INLINE void forceOnOther(int j, const Vec3& f) noexcept {
+        if (owns(j)) {
+            force[j] -= f;
+        } else {
+            bufferedForce[j] -= f;
+            lowestBuffered = std::min(lowestBuffered, j);
+            highestBuffered = std::max(highestBuffered, j);
+        }
+    }
+};
 
 template <RollingModel Rolling, CohesionModel Cohesion>
 class ContactForceKernelImpl final : public ContactForceKernel {
@@ -41,18 +79,19 @@ public:
             pairs.setStateFields({have.rollingTorque || need.rollingTorque, have.bridgeVolume || need.bridgeVolume});
         const int n = static_cast<int>(p.size());
         const int threads = threadsFor(n, heavyLoopParticlesPerThread);
-        // Thread 0 accumulates into the particle arrays; the others into their own
-        // buffers, added afterwards in thread order: the sums, and so the results,
-        // are the same in every run with the same thread count.  The buffers are
-        // kept zero between steps (the reduction below clears what it adds), so
-        // no serial clearing pass is needed.
-        buffers_.resize(threads);
-        for (int t = 1; t < threads; ++t) {
-            if (buffers_[t].force.size() != static_cast<std::size_t>(n)) {
-                buffers_[t].force.assign(n, Vec3::Zero());
-                buffers_[t].torque.assign(n, Vec3::Zero());
+        // Each thread adds into the particle arrays for its own rows and into its
+        // own buffer for other threads' particles; after a barrier every thread
+        // adds, for its own rows, the other threads' buffers in thread order and
+        // clears them.  The sums, and so the results, are the same in every run
+        // with the same thread count.  The buffers are kept zero between steps.
+        buffers_.resize(threads > 1 ? threads : 0);
+        for (auto& buffer : buffers_) {
+            if (buffer.force.size() != static_cast<std::size_t>(n)) {
+                buffer.force.assign(n, Vec3::Zero());
+                buffer.torque.assign(n, Vec3::Zero());
             }
         }
+        bufferedRanges_.assign(threads, {0, 0});
         std::vector<ContactStatistics> stats(threads);
         changes_.resize(threads);
         for (auto& c : changes_) c.clear();
@@ -74,28 +113,42 @@ public:
 #pragma omp parallel num_threads(threads)
         {
             const int t = threadIndex();
-            Vec3* force = t == 0 ? p.force.data() : buffers_[t].force.data();
-            Vec3* torque = t == 0 ? p.torque.data() : buffers_[t].torque.data();
             const int begin = rowSplit(t);
             const int end = rowSplit(t + 1);
+            ForceSink sink{p.force.data(), p.torque.data(), threads > 1 ? buffers_[t].force.data() : nullptr,
+                           threads > 1 ? buffers_[t].torque.data() : nullptr, begin, end};
+            // Counters, the history changes and the wall records live on this
+            // thread's stack while it works: their slots in the per-thread
+            // vectors share cache lines, and a counter or vector header written
+            // there at every contact made the two cores fight over those lines
+            // (the wall loop did not scale with the thread count at all).
+            ContactStatistics localStats;
+            ContactHistoryPool::Changes changes = std::move(changes_[t]);
+            std::vector<WallContactRecord> wallRecords = std::move(newWall[t]);
             if (settings_.vectorizedPairLaw)
-                pairForcesBatched(p, pairs, interactions, dt, begin, end, force, torque, stats[t], changes_[t],
-                                  *batches_[t]);
+                pairForcesBatched(p, pairs, interactions, dt, sink, localStats, changes, *batches_[t]);
             else
-                pairForces(p, pairs, interactions, dt, begin, end, force, torque, stats[t], changes_[t]);
-            wallForces(p, wallContacts, walls, wallCandidates, interactions, time, dt, begin, end, force,
-                       torque, newWall[t], stats[t]);
+                pairForces(p, pairs, interactions, dt, sink, localStats, changes);
+            wallForces(p, wallContacts, walls, wallCandidates, interactions, time, dt, begin, end, p.force.data(),
+                       p.torque.data(), wallRecords, localStats);
+            stats[t] = localStats;
+            changes_[t] = std::move(changes);
+            newWall[t] = std::move(wallRecords);
             if (threads > 1) {
-                // The other threads' sums, added in thread order in the same
-                // parallel region (no second fork), and cleared for the next step.
+                bufferedRanges_[t] = {sink.lowestBuffered, sink.highestBuffered + 1};
 #pragma omp barrier
-#pragma omp for schedule(static)
-                for (int i = 0; i < n; ++i) {
-                    for (int u = 1; u < threads; ++u) {
-                        p.force[i] += buffers_[u].force[i];
-                        p.torque[i] += buffers_[u].torque[i];
-                        buffers_[u].force[i].setZero();
-                        buffers_[u].torque[i].setZero();
+                // The other threads' contributions to this thread's rows, in thread order.
+                for (int u = 0; u < threads; ++u) {
+                    if (u == t) continue;
+                    const int from = std::max(begin, bufferedRanges_[u].first);
+                    const int to = std::min(end, bufferedRanges_[u].second);
+                    Vec3* otherForce = buffers_[u].force.data();
+                    Vec3* otherTorque = buffers_[u].torque.data();
+                    for (int i = from; i < to; ++i) {
+                        p.force[i] += otherForce[i];
+                        p.torque[i] += otherTorque[i];
+                        otherForce[i].setZero();
+                        otherTorque[i].setZero();
                     }
                 }
             }
@@ -126,6 +179,7 @@ private:
         std::vector<Vec3> torque;
     };
     std::vector<Buffer> buffers_;
+    std::vector<std::pair<int, int>> bufferedRanges_;  // per thread: [lowest, highest + 1) buffered
     std::vector<ContactHistoryPool::Changes> changes_;  // per thread, reused
     std::vector<std::unique_ptr<ContactBatch>> batches_;  // per thread, reused (45 kB each)
     std::vector<std::vector<WallContactRecord>> newWall_;  // per thread, reused
@@ -133,8 +187,10 @@ private:
     // The scalar pair loop (settings_.vectorizedPairLaw = false): one contact
     // after the other through ContactLaw::evaluate; the reference of pairForcesBatched.
     void pairForces(ParticleStore& p, ParticleParticleNeighborList& pairs,
-                    const InteractionTable& interactions, double dt, int begin, int end, Vec3* force,
-                    Vec3* torque, ContactStatistics& stats, ContactHistoryPool::Changes& changes) const {
+                    const InteractionTable& interactions, double dt, ForceSink& sink, ContactStatistics& stats,
+                    ContactHistoryPool::Changes& changes) const {
+        const int begin = sink.begin;
+        const int end = sink.end;
         constexpr bool keepsRolling = Rolling == RollingModel::EPSD || Rolling == RollingModel::EPSD2;
         const int* offsets = pairs.offsets().data();
         const int* neighbors = pairs.neighbors().data();
@@ -192,7 +248,7 @@ private:
                         if (cohesiveForce != 0.0) {
                             const Vec3 f = cohesiveForce * normal;
                             fi += f;
-                            force[j] -= f;
+                            sink.forceOnOther(j, f);
                         }
                         continue;
                     }
@@ -234,13 +290,12 @@ private:
                     changes.opened.push_back({k, history});
                 }
                 fi += f.force;
-                force[j] -= f.force;
                 const Vec3 nxFt = normal.cross(f.tangentialForce);
                 ti += -ci * nxFt + f.rollingTorque;
-                torque[j] += -cj * nxFt - f.rollingTorque;
+                sink.onOther(j, f.force, -cj * nxFt - f.rollingTorque);
             }
-            force[i] += fi;
-            torque[i] += ti;
+            sink.force[i] += fi;
+            sink.torque[i] += ti;
         }
         stats.touchingPairs += touchingPairs;
     }
@@ -253,9 +308,10 @@ private:
     // in list order.  A row may span batches (its sums are carried over).  The
     // results are bitwise those of pairForces (same operations, same sums).
     void pairForcesBatched(ParticleStore& p, ParticleParticleNeighborList& pairs,
-                           const InteractionTable& interactions, double dt, int begin, int end, Vec3* force,
-                           Vec3* torque, ContactStatistics& stats, ContactHistoryPool::Changes& changes,
-                           ContactBatch& b) const {
+                           const InteractionTable& interactions, double dt, ForceSink& sink,
+                           ContactStatistics& stats, ContactHistoryPool::Changes& changes, ContactBatch& b) const {
+        const int begin = sink.begin;
+        const int end = sink.end;
         constexpr bool keepsRolling = Rolling == RollingModel::EPSD || Rolling == RollingModel::EPSD2;
         constexpr int capacity = ContactBatch::capacity;
         const int* offsets = pairs.offsets().data();
@@ -370,8 +426,8 @@ private:
 
             // Pass 3: sums in list order; every row before pass 1's cursor is complete.
             auto closeRow = [&]() {
-                force[sumRow] += fi;
-                torque[sumRow] += ti;
+                sink.force[sumRow] += fi;
+                sink.torque[sumRow] += ti;
                 fi.setZero();
                 ti.setZero();
                 ++sumRow;
@@ -381,12 +437,14 @@ private:
                 const int j = b.particleJ[e];
                 const Vec3 f(b.fx[e], b.fy[e], b.fz[e]);
                 fi += f;
-                force[j] -= f;
                 if constexpr (Cohesion == CohesionModel::Capillary) {
-                    if (b.touching[e] == 0.0) continue;  // a bridge beyond contact: no torque, no history
+                    if (b.touching[e] == 0.0) {  // a bridge beyond contact: no torque, no history
+                        sink.forceOnOther(j, f);
+                        continue;
+                    }
                 }
                 ti += Vec3(b.tix[e], b.tiy[e], b.tiz[e]);
-                torque[j] += Vec3(b.tjx[e], b.tjy[e], b.tjz[e]);
+                sink.onOther(j, f, Vec3(b.tjx[e], b.tjy[e], b.tjz[e]));
                 // History back to its record, or to the pool's new records after the loop.
                 const int s = slot[b.entry[e]];
                 if (s >= 0) {
