@@ -83,7 +83,7 @@ _tutorial_diefillFoam() { diefillFoam >> log.diefillFoam 2>&1; }
 
 tutorial_run_demRun() {
     rm -rf dem log.demRun
-    OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-passive} tutorial_timed_run demRun log.demRun _tutorial_demRun
+    tutorial_timed_run demRun log.demRun _tutorial_demRun
 }
 
 # Time folders of the air after 0, in order
@@ -117,8 +117,7 @@ tutorial_prepare_air() {
 
 tutorial_run_diefillFoam() {
     [ -d dem/restart ] && [ -n "$(tutorial_air_times)" ] || rm -rf dem
-    OMP_NUM_THREADS=$THREADS OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-passive} \
-        tutorial_timed_run diefillFoam log.diefillFoam _tutorial_diefillFoam
+    OMP_NUM_THREADS=$THREADS tutorial_timed_run diefillFoam log.diefillFoam _tutorial_diefillFoam
 }
 
 tutorial_clean_air() {

@@ -328,7 +328,10 @@ private:
         Vec3 fi = Vec3::Zero();
         Vec3 ti = Vec3::Zero();
         while (row < end) {
-            // Pass 1.
+            // Pass 1a: the touching test over the listed pairs, in list order.
+            // Without cohesion it selects without a branch: every pair is
+            // written at the next free entry and the count grows by one if it
+            // touches (the test is a coin toss for the branch predictor).
             int count = 0;
             for (; row < end; ++row) {
                 const Vec3 xi = p.position[row];
@@ -347,16 +350,16 @@ private:
                             slot[k] = -1;
                         }
                     };
-                    double cohesiveForce = 0.0;
-                    bool touching = true;
+                    const int e = count;
                     if constexpr (Cohesion == CohesionModel::None) {
-                        if (dist2 >= radiusSum * radiusSum) {
-                            forget();
-                            continue;
-                        }
+                        const bool touching = !(dist2 >= radiusSum * radiusSum);
+                        if ((slot[k] >= 0) & !touching) forget();  // rare: a contact that opened
+                        count += touching;
                     } else {
                         // The bridge needs the gap of every listed pair (the lanes
                         // compute the same root and normal again).
+                        double cohesiveForce = 0.0;
+                        bool touching = true;
                         const double overlap = radiusSum - std::sqrt(dist2);
                         double& volume = bridge[k];
                         if (volume > 0.0) {
@@ -375,52 +378,59 @@ private:
                             if (cohesiveForce == 0.0) continue;
                             touching = false;  // a bridge beyond contact: a force entry only
                         }
-                    }
-                    touchingPairs += touching;
-                    const int e = count++;
-                    if constexpr (Cohesion == CohesionModel::Capillary) {
                         b.extraNormalForce[e] = cohesiveForce;
                         b.touching[e] = touching ? 1.0 : 0.0;
+                        touchingPairs += touching;
+                        ++count;
                     }
                     b.entry[e] = k;
                     b.particleI[e] = row;
                     b.particleJ[e] = j;
-                    b.properties[e] = &interactions(p.material[row], p.material[j]);
                     b.dx[e] = d.x();
                     b.dy[e] = d.y();
                     b.dz[e] = d.z();
                     b.distanceSquared[e] = dist2;
                     b.radiusI[e] = ri;
                     b.radiusJ[e] = rj;
-                    b.massI[e] = p.mass[row];
-                    b.massJ[e] = p.mass[j];
-                    const Vec3 dv = p.velocity[row] - p.velocity[j];
-                    b.dvx[e] = dv.x();
-                    b.dvy[e] = dv.y();
-                    b.dvz[e] = dv.z();
-                    const Vec3& wi = p.omega[row];
-                    const Vec3& wj = p.omega[j];
-                    b.wix[e] = wi.x();
-                    b.wiy[e] = wi.y();
-                    b.wiz[e] = wi.z();
-                    b.wjx[e] = wj.x();
-                    b.wjy[e] = wj.y();
-                    b.wjz[e] = wj.z();
-                    // A contact without a slot is new: its springs start from zero.
-                    const int s = slot[k];
-                    const double* record = s >= 0 ? records + s * stride : nullptr;
-                    b.sx[e] = record ? record[0] : 0.0;
-                    b.sy[e] = record ? record[1] : 0.0;
-                    b.sz[e] = record ? record[2] : 0.0;
-                    if constexpr (keepsRolling) {
-                        b.mx[e] = record ? record[3] : 0.0;
-                        b.my[e] = record ? record[4] : 0.0;
-                        b.mz[e] = record ? record[5] : 0.0;
-                    }
                 }
                 if (k < rowEnd) break;  // batch full inside this row
                 if (row + 1 < end) k = offsets[row + 1];
             }
+            if constexpr (Cohesion == CohesionModel::None) touchingPairs += count;
+
+            // Pass 1b: the rest of the selected pairs' inputs.
+            for (int e = 0; e < count; ++e) {
+                const int i = b.particleI[e];
+                const int j = b.particleJ[e];
+                b.properties[e] = &interactions(p.material[i], p.material[j]);
+                b.massI[e] = p.mass[i];
+                b.massJ[e] = p.mass[j];
+                const Vec3 dv = p.velocity[i] - p.velocity[j];
+                b.dvx[e] = dv.x();
+                b.dvy[e] = dv.y();
+                b.dvz[e] = dv.z();
+                const Vec3& wi = p.omega[i];
+                const Vec3& wj = p.omega[j];
+                b.wix[e] = wi.x();
+                b.wiy[e] = wi.y();
+                b.wiz[e] = wi.z();
+                b.wjx[e] = wj.x();
+                b.wjy[e] = wj.y();
+                b.wjz[e] = wj.z();
+                // A contact without a slot is new: its springs start from zero.
+                // (A bridge beyond contact has no slot: forgotten above.)
+                const int s = slot[b.entry[e]];
+                const double* record = s >= 0 ? records + s * stride : nullptr;
+                b.sx[e] = record ? record[0] : 0.0;
+                b.sy[e] = record ? record[1] : 0.0;
+                b.sz[e] = record ? record[2] : 0.0;
+                if constexpr (keepsRolling) {
+                    b.mx[e] = record ? record[3] : 0.0;
+                    b.my[e] = record ? record[4] : 0.0;
+                    b.mz[e] = record ? record[5] : 0.0;
+                }
+            }
+
             // Pass 2: the law in vector lanes.
             if (count > 0) evaluateContactBatch<Rolling, Cohesion == CohesionModel::Capillary>(b, count, dt);
 
