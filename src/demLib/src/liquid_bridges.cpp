@@ -108,6 +108,7 @@ const BridgeDistribution& LiquidBridgeNetwork::update(const BridgeCandidates& ca
     weight_.resize(pairCount);
     stabilityThreshold_.resize(pairCount);
     rankedPairs_.clear();
+    separatedPairs_.clear();
 
     // λ*_k: the liquid per unit weight at which pair k's own bridge reaches its
     // debonding distance, gap_k = (1+θ/2)(λ w_k)^(1/3).  Overlapping pairs: 0.
@@ -124,14 +125,17 @@ const BridgeDistribution& LiquidBridgeNetwork::update(const BridgeCandidates& ca
         weight_[k] = bridgeVolumeWeight(ra, rb, distance, settings_.weight);
         const double scaledGap = std::max(gap, 0.0) / debondingPrefactor;
         stabilityThreshold_[k] = scaledGap * scaledGap * scaledGap / weight_[k];
-        rankedPairs_.push_back(k);
+        if (stabilityThreshold_[k] > 0.0)
+            separatedPairs_.emplace_back(stabilityThreshold_[k], k);
+        else
+            rankedPairs_.push_back(k);
     }
 
-    // Rank by stability (ties by index, so the result is deterministic).
-    std::sort(rankedPairs_.begin(), rankedPairs_.end(), [this](std::size_t a, std::size_t b) {
-        if (stabilityThreshold_[a] != stabilityThreshold_[b]) return stabilityThreshold_[a] < stabilityThreshold_[b];
-        return a < b;
-    });
+    // Rank by stability (ties by index, so the result is deterministic).  The
+    // touching pairs (λ* = 0) come first, already in index order; the separated
+    // ones are sorted as (λ*, index) keys held together (no indirect compares).
+    std::sort(separatedPairs_.begin(), separatedPairs_.end());
+    for (const auto& key : separatedPairs_) rankedPairs_.push_back(key.second);
 
     // Accept whole groups of equal λ* while the group's own bridges stay stable
     // with the liquid shared over everything accepted so far: λ* · W ≤ V.

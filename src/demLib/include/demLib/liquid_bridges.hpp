@@ -19,6 +19,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace dem {
@@ -102,6 +103,7 @@ private:
     BridgeDistribution distribution_;
     // scratch, reused between updates
     std::vector<std::size_t> rankedPairs_;
+    std::vector<std::pair<double, std::size_t>> separatedPairs_;  // (λ*, index) of candidates with a gap
     std::vector<double> weight_;
     std::vector<double> stabilityThreshold_;
 };
