@@ -239,7 +239,7 @@ private:
                             volume = 0.0;
                         } else {
                             cohesiveForce = settings_.capillaryForceScale *
-                                            capillaryForce(ri, rj, gap, volume, settings_.capillary);
+                                            capillaryForceWithinReach(ri, rj, gap, volume, settings_.capillary);
                             ++stats.bridges;
                         }
                     }
@@ -369,7 +369,7 @@ private:
                                 volume = 0.0;
                             } else {
                                 cohesiveForce = settings_.capillaryForceScale *
-                                                capillaryForce(ri, rj, gap, volume, settings_.capillary);
+                                                capillaryForceWithinReach(ri, rj, gap, volume, settings_.capillary);
                                 ++stats.bridges;
                             }
                         }

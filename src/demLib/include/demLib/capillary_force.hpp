@@ -55,13 +55,11 @@ inline double debondingDistance(double bridgeVolume, double contactAngle) {
     return (1.0 + 0.5 * contactAngle) * std::cbrt(bridgeVolume);
 }
 
-// Eq 1 between spheres of radii R1, R2 (either order) separated by `gap`
-// (surface-to-surface; negative when they overlap) and joined by a bridge of
-// volume `bridgeVolume`.  Zero when there is no liquid or gap > δmax (eq 5).
-inline double capillaryForce(double radius1, double radius2, double gap, double bridgeVolume,
-                             const CapillaryParameters& parameters) {
-    if (!(bridgeVolume > 0.0)) return 0.0;
-    if (gap > debondingDistance(bridgeVolume, parameters.contactAngle)) return 0.0;
+// capillaryForce for a bridge already known to hold liquid and to lie within its
+// debonding distance (the contact loop tests that first, to release broken
+// bridges): the same value without computing eq 5 a second time.
+inline double capillaryForceWithinReach(double radius1, double radius2, double gap, double bridgeVolume,
+                                        const CapillaryParameters& parameters) {
     if (radius1 > radius2) std::swap(radius1, radius2);  // the fit is written for R1 ≤ R2
     const double largerRadius = radius2;
     const double reducedVolume = bridgeVolume / (largerRadius * largerRadius * largerRadius);
@@ -70,6 +68,16 @@ inline double capillaryForce(double radius1, double radius2, double gap, double 
     const double shape = reducedGap > 0.0 ? std::exp(fit.A * reducedGap + fit.B) + fit.C
                                           : std::exp(fit.B) + fit.C;
     return -capillary_detail::pi * parameters.surfaceTension * std::sqrt(radius1 * radius2) * shape;
+}
+
+// Eq 1 between spheres of radii R1, R2 (either order) separated by `gap`
+// (surface-to-surface; negative when they overlap) and joined by a bridge of
+// volume `bridgeVolume`.  Zero when there is no liquid or gap > δmax (eq 5).
+inline double capillaryForce(double radius1, double radius2, double gap, double bridgeVolume,
+                             const CapillaryParameters& parameters) {
+    if (!(bridgeVolume > 0.0)) return 0.0;
+    if (gap > debondingDistance(bridgeVolume, parameters.contactAngle)) return 0.0;
+    return capillaryForceWithinReach(radius1, radius2, gap, bridgeVolume, parameters);
 }
 
 // The radius of the sphere pair that stands in for a sphere-plane bridge.
