@@ -38,7 +38,9 @@ TEST(SpatialOrder, IsAPermutationGroupingEachCellContiguously) {
     }
     // Stable within a cell: old indices ascend.
     for (std::size_t k = 1; k < order.size(); ++k)
-        if (key(order[k - 1]) == key(order[k])) EXPECT_LT(order[k - 1], order[k]);
+        if (key(order[k - 1]) == key(order[k])) {
+            EXPECT_LT(order[k - 1], order[k]);
+        }
     const std::vector<int> inverse = dem::inversePermutation(order);
     for (std::size_t k = 0; k < order.size(); ++k) EXPECT_EQ(inverse[order[k]], static_cast<int>(k));
 }
