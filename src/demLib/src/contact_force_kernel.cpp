@@ -184,6 +184,21 @@ private:
     std::vector<std::unique_ptr<ContactBatch>> batches_;  // per thread, reused (45 kB each)
     std::vector<std::vector<WallContactRecord>> newWall_;  // per thread, reused
 
+    // The capillary force of a pair's bridge (0 without liquid).  A bridge whose
+    // gap exceeds its debonding distance (eq 5) breaks: its liquid goes back to
+    // the free pool (stats.releasedLiquid).
+    double bridgeForce(double& volume, double overlap, double ri, double rj, ContactStatistics& stats) const {
+        if (!(volume > 0.0)) return 0.0;
+        const double gap = -overlap;
+        if (gap > debondingDistance(volume, settings_.capillary.contactAngle)) {
+            stats.releasedLiquid += volume;  // back to the free liquid
+            volume = 0.0;
+            return 0.0;
+        }
+        ++stats.bridges;
+        return settings_.capillaryForceScale * capillaryForceWithinReach(ri, rj, gap, volume, settings_.capillary);
+    }
+
     // The scalar pair loop (settings_.vectorizedPairLaw = false): one contact
     // after the other through ContactLaw::evaluate; the reference of pairForcesBatched.
     void pairForces(ParticleStore& p, ParticleParticleNeighborList& pairs,
@@ -231,18 +246,7 @@ private:
 
                 double cohesiveForce = 0.0;
                 if constexpr (Cohesion == CohesionModel::Capillary) {
-                    double& volume = bridge[k];
-                    if (volume > 0.0) {
-                        const double gap = -overlap;
-                        if (gap > debondingDistance(volume, settings_.capillary.contactAngle)) {
-                            stats.releasedLiquid += volume;  // back to the free liquid
-                            volume = 0.0;
-                        } else {
-                            cohesiveForce = settings_.capillaryForceScale *
-                                            capillaryForceWithinReach(ri, rj, gap, volume, settings_.capillary);
-                            ++stats.bridges;
-                        }
-                    }
+                    cohesiveForce = bridgeForce(bridge[k], overlap, ri, rj, stats);
                     if (overlap <= 0.0) {
                         forget(k);
                         if (cohesiveForce != 0.0) {
@@ -358,21 +362,9 @@ private:
                     } else {
                         // The bridge needs the gap of every listed pair (the lanes
                         // compute the same root and normal again).
-                        double cohesiveForce = 0.0;
                         bool touching = true;
                         const double overlap = radiusSum - std::sqrt(dist2);
-                        double& volume = bridge[k];
-                        if (volume > 0.0) {
-                            const double gap = -overlap;
-                            if (gap > debondingDistance(volume, settings_.capillary.contactAngle)) {
-                                stats.releasedLiquid += volume;  // back to the free liquid
-                                volume = 0.0;
-                            } else {
-                                cohesiveForce = settings_.capillaryForceScale *
-                                                capillaryForceWithinReach(ri, rj, gap, volume, settings_.capillary);
-                                ++stats.bridges;
-                            }
-                        }
+                        const double cohesiveForce = bridgeForce(bridge[k], overlap, ri, rj, stats);
                         if (overlap <= 0.0) {
                             forget();
                             if (cohesiveForce == 0.0) continue;
