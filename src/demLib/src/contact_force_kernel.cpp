@@ -38,18 +38,7 @@ struct ForceSink {
     int highestBuffered = -1;
 
     DEM_ALWAYS_INLINE bool owns(int j) const noexcept { return j >= begin && j < end; }
-    // force[j] -= f and torque[j] += t, here or in the buffer.
-    DEM_ALWAYS_INLINE void onOther(int j, const Vec3& f, const Vec3& t) noexcept {
-        if (owns(j)) {
-            force[j] -= f;
-            torque[j] += t;
-        } else {
-            bufferedForce[j] -= f;
-            bufferedTorque[j] += t;
-            lowestBuffered = std::min(lowestBuffered, j);
-            highestBuffered = std::max(highestBuffered, j);
-        }
-    }
+    // force[j] -= f, here or in the buffer (whose written range grows to j).
     DEM_ALWAYS_INLINE void forceOnOther(int j, const Vec3& f) noexcept {
         if (owns(j)) {
             force[j] -= f;
@@ -58,6 +47,11 @@ struct ForceSink {
             lowestBuffered = std::min(lowestBuffered, j);
             highestBuffered = std::max(highestBuffered, j);
         }
+    }
+    // force[j] -= f and torque[j] += t.
+    DEM_ALWAYS_INLINE void onOther(int j, const Vec3& f, const Vec3& t) noexcept {
+        forceOnOther(j, f);
+        (owns(j) ? torque : bufferedTorque)[j] += t;
     }
 };
 
@@ -184,19 +178,46 @@ private:
     std::vector<std::unique_ptr<ContactBatch>> batches_;  // per thread, reused (45 kB each)
     std::vector<std::vector<WallContactRecord>> newWall_;  // per thread, reused
 
-    // The capillary force of a pair's bridge (0 without liquid).  A bridge whose
-    // gap exceeds its debonding distance (eq 5) breaks: its liquid goes back to
-    // the free pool (stats.releasedLiquid).
-    double bridgeForce(double& volume, double overlap, double ri, double rj, ContactStatistics& stats) const {
+    // The pair list's arrays as the pair loops read and write them.
+    struct PairListArrays {
+        const int* offsets;
+        const int* neighbors;
+        int* slot;          // history slot per listed pair (-1: none)
+        double* records;    // history records; slots are only handed out after the loop
+        std::size_t stride;  // doubles per record
+        double* bridge;     // bridge volume per listed pair (capillary only, else null)
+    };
+    static PairListArrays arraysOf(ParticleParticleNeighborList& pairs) {
+        ContactHistoryPool& pool = pairs.history();
+        return {pairs.offsets().data(), pairs.neighbors().data(), pool.slots(), pool.record(0), pool.stride(),
+                Cohesion == CohesionModel::Capillary ? pairs.bridgeVolume().data() : nullptr};
+    }
+
+    // A contact that opens forgets its springs (LIGGGHTS surfacesClose): its
+    // history slot goes back to the pool.
+    static void forgetSprings(int* slot, int k, ContactHistoryPool::Changes& changes) {
+        if (slot[k] >= 0) {
+            changes.released.push_back(slot[k]);
+            slot[k] = -1;
+        }
+    }
+
+    // The capillary force of a bridge between spheres of radii r1, r2 (a wall:
+    // wallEquivalentRadius twice), 0 without liquid.  A bridge whose gap exceeds
+    // its debonding distance (eq 5) breaks: volume is set to 0 and its liquid
+    // goes back to the free pool (releasedLiquid); a bridge that holds counts
+    // in `holding`.
+    double bridgeForce(double& volume, double overlap, double r1, double r2, std::size_t& holding,
+                       double& releasedLiquid) const {
         if (!(volume > 0.0)) return 0.0;
         const double gap = -overlap;
         if (gap > debondingDistance(volume, settings_.capillary.contactAngle)) {
-            stats.releasedLiquid += volume;  // back to the free liquid
+            releasedLiquid += volume;  // back to the free liquid
             volume = 0.0;
             return 0.0;
         }
-        ++stats.bridges;
-        return settings_.capillaryForceScale * capillaryForceWithinReach(ri, rj, gap, volume, settings_.capillary);
+        ++holding;
+        return settings_.capillaryForceScale * capillaryForceWithinReach(r1, r2, gap, volume, settings_.capillary);
     }
 
     // The scalar pair loop (settings_.vectorizedPairLaw = false): one contact
@@ -207,21 +228,7 @@ private:
         const int begin = sink.begin;
         const int end = sink.end;
         constexpr bool keepsRolling = Rolling == RollingModel::EPSD || Rolling == RollingModel::EPSD2;
-        const int* offsets = pairs.offsets().data();
-        const int* neighbors = pairs.neighbors().data();
-        ContactHistoryPool& pool = pairs.history();
-        int* slot = pool.slots();
-        double* records = pool.record(0);  // slots are only handed out after the loop
-        const std::size_t stride = pool.stride();
-        double* bridge = Cohesion == CohesionModel::Capillary ? pairs.bridgeVolume().data() : nullptr;
-        // A contact that opens forgets its springs (LIGGGHTS surfacesClose):
-        // its history slot goes back to the pool.
-        auto forget = [&](int k) {
-            if (slot[k] >= 0) {
-                changes.released.push_back(slot[k]);
-                slot[k] = -1;
-            }
-        };
+        const auto [offsets, neighbors, slot, records, stride, bridge] = arraysOf(pairs);
         std::size_t touchingPairs = 0;  // a register, not a store per contact
         for (int i = begin; i < end; ++i) {
             const Vec3 xi = p.position[i];
@@ -236,7 +243,7 @@ private:
                 const double dist2 = d.squaredNorm();
                 if constexpr (Cohesion == CohesionModel::None) {
                     if (dist2 >= radiusSum * radiusSum) {
-                        forget(k);
+                        forgetSprings(slot, k, changes);
                         continue;
                     }
                 }
@@ -246,9 +253,9 @@ private:
 
                 double cohesiveForce = 0.0;
                 if constexpr (Cohesion == CohesionModel::Capillary) {
-                    cohesiveForce = bridgeForce(bridge[k], overlap, ri, rj, stats);
+                    cohesiveForce = bridgeForce(bridge[k], overlap, ri, rj, stats.bridges, stats.releasedLiquid);
                     if (overlap <= 0.0) {
-                        forget(k);
+                        forgetSprings(slot, k, changes);
                         if (cohesiveForce != 0.0) {
                             const Vec3 f = cohesiveForce * normal;
                             fi += f;
@@ -318,13 +325,7 @@ private:
         const int end = sink.end;
         constexpr bool keepsRolling = Rolling == RollingModel::EPSD || Rolling == RollingModel::EPSD2;
         constexpr int capacity = ContactBatch::capacity;
-        const int* offsets = pairs.offsets().data();
-        const int* neighbors = pairs.neighbors().data();
-        ContactHistoryPool& pool = pairs.history();
-        int* slot = pool.slots();
-        double* records = pool.record(0);  // slots are only handed out after the loop
-        const std::size_t stride = pool.stride();
-        double* bridge = Cohesion == CohesionModel::Capillary ? pairs.bridgeVolume().data() : nullptr;
+        const auto [offsets, neighbors, slot, records, stride, bridge] = arraysOf(pairs);
         std::size_t touchingPairs = 0;
         int row = begin;                      // pass 1's cursor: row and list entry
         int k = begin < end ? offsets[begin] : 0;
@@ -347,26 +348,19 @@ private:
                     const double rj = p.radius[j];
                     const double radiusSum = ri + rj;
                     const double dist2 = d.squaredNorm();
-                    // A contact that opens forgets its springs (LIGGGHTS surfacesClose).
-                    auto forget = [&]() {
-                        if (slot[k] >= 0) {
-                            changes.released.push_back(slot[k]);
-                            slot[k] = -1;
-                        }
-                    };
                     const int e = count;
                     if constexpr (Cohesion == CohesionModel::None) {
                         const bool touching = !(dist2 >= radiusSum * radiusSum);
-                        if ((slot[k] >= 0) & !touching) forget();  // rare: a contact that opened
+                        if ((slot[k] >= 0) & !touching) forgetSprings(slot, k, changes);  // rare: a contact that opened
                         count += touching;
                     } else {
                         // The bridge needs the gap of every listed pair (the lanes
                         // compute the same root and normal again).
                         bool touching = true;
                         const double overlap = radiusSum - std::sqrt(dist2);
-                        const double cohesiveForce = bridgeForce(bridge[k], overlap, ri, rj, stats);
+                        const double cohesiveForce = bridgeForce(bridge[k], overlap, ri, rj, stats.bridges, stats.releasedLiquid);
                         if (overlap <= 0.0) {
-                            forget();
+                            forgetSprings(slot, k, changes);
                             if (cohesiveForce == 0.0) continue;
                             touching = false;  // a bridge beyond contact: a force entry only
                         }
@@ -495,16 +489,12 @@ private:
                 rec.feature = c.feature;
                 const WallContactRecord* prev = old.find(i, w, c.feature);
                 double cohesiveForce = 0.0;
-                if (bridges && prev && prev->bridgeVolume > 0.0) {
-                    const double gap = -c.overlap;
-                    if (gap > debondingDistance(prev->bridgeVolume, settings_.capillary.contactAngle)) {
-                        stats.releasedLiquid += prev->bridgeVolume;  // back to the free liquid
-                    } else {
-                        rec.bridgeVolume = prev->bridgeVolume;
-                        cohesiveForce = settings_.capillaryForceScale *
-                                        capillaryForceSphereWall(ri, gap, prev->bridgeVolume, settings_.capillary);
-                        ++stats.wallBridges;
-                    }
+                if (bridges && prev) {
+                    // The sphere-wall bridge as the pair bridge of capillaryForceSphereWall.
+                    const double equivalentRadius = wallEquivalentRadius(ri);
+                    rec.bridgeVolume = prev->bridgeVolume;
+                    cohesiveForce = bridgeForce(rec.bridgeVolume, c.overlap, equivalentRadius, equivalentRadius,
+                                                stats.wallBridges, stats.releasedLiquid);
                 }
                 if (!touching) {
                     // Within the bridge reach only: no contact history, the

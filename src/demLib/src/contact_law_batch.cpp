@@ -6,8 +6,7 @@ namespace dem {
 
 namespace {
 
-// Material-pair constants: one set for the whole batch (Uniform) or one per lane.
-template <bool Uniform>
+// Material-pair constants: one set for the whole batch (read at [0]) or one per lane.
 struct PairConstants {
     const double *kn, *kt, *gn, *gt, *mu, *muR, *etaR;
 };
@@ -17,7 +16,7 @@ struct PairConstants {
 // the same order.  The comments name the scalar expression each line mirrors.
 
 template <RollingModel Rolling, bool Cohesive, bool Uniform>
-DEM_ALWAYS_INLINE void evaluateBatchBody(ContactBatch& b, int count, double dt, const PairConstants<Uniform>& c) {
+DEM_ALWAYS_INLINE void evaluateBatchBody(ContactBatch& b, int count, double dt, const PairConstants& c) {
     using Settings = LiggghtsDefaultContactSettings;
     static_assert(!Settings::limitForce && Settings::tangentialDamping && !Settings::cohesionInFrictionLimits,
                   "the batch mirrors the default switches of ContactLaw");
@@ -208,7 +207,7 @@ DEM_VECTOR_CLONES void evaluateContactBatch(ContactBatch& batch, int count, doub
     bool uniform = true;
     for (int e = 1; e < count; ++e) uniform = uniform && batch.properties[e] == first;
     if (uniform) {
-        const PairConstants<true> c{&first->normalStiffnessFactor, &first->tangentialStiffnessFactor,
+        const PairConstants c{&first->normalStiffnessFactor, &first->tangentialStiffnessFactor,
                                     &first->normalDampingFactor,   &first->tangentialDampingFactor,
                                     &first->friction,              &first->rollingFriction,
                                     &first->rollingViscousDamping};
@@ -225,7 +224,7 @@ DEM_VECTOR_CLONES void evaluateContactBatch(ContactBatch& batch, int count, doub
         batch.rollingFriction[e] = props.rollingFriction;
         batch.rollingViscousDamping[e] = props.rollingViscousDamping;
     }
-    const PairConstants<false> c{batch.normalStiffnessFactor, batch.tangentialStiffnessFactor,
+    const PairConstants c{batch.normalStiffnessFactor, batch.tangentialStiffnessFactor,
                                  batch.normalDampingFactor,   batch.tangentialDampingFactor,
                                  batch.friction,              batch.rollingFriction,
                                  batch.rollingViscousDamping};
