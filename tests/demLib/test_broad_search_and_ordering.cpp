@@ -10,24 +10,22 @@
 
 using dem::Vec3;
 
-TEST(SpatialOrder, IsAPermutationGroupingEachCellContiguously) {
-    std::mt19937_64 rng(3);
-    std::uniform_real_distribution<double> u(0.0, 1.0);
-    std::vector<Vec3> x(5000);
-    for (Vec3& p : x) p = Vec3(u(rng), u(rng), 0.5 * u(rng));
-    const double cell = 0.1;
-    const std::vector<int> order = dem::spatialOrder(x, cell);
+namespace {
+
+// Checks that order is a permutation that visits the cells in the key order
+// given (cell coordinates counted from the particles' lower corner, as the
+// grid does), each cell as one run, old indices ascending inside a cell.
+template <class CellKey>
+void expectCellOrder(const std::vector<Vec3>& x, const std::vector<int>& order, double cell, CellKey cellKey) {
     ASSERT_EQ(order.size(), x.size());
     std::vector<int> sorted = order;
     std::sort(sorted.begin(), sorted.end());
     for (int k = 0; k < static_cast<int>(sorted.size()); ++k) ASSERT_EQ(sorted[k], k);
-    // Cell keys never decrease along the new order, and each cell is one run.
-    // Cells are counted from the particles' lower corner, as the grid is.
     Vec3 lo = x[0];
     for (const Vec3& p : x) lo = lo.cwiseMin(p);
     auto key = [&](int i) {
         const Vec3 r = (x[i] - lo) / cell;
-        return (static_cast<long>(r.z()) * 100 + static_cast<long>(r.y())) * 100 + static_cast<long>(r.x());
+        return cellKey(static_cast<long>(r.x()), static_cast<long>(r.y()), static_cast<long>(r.z()));
     };
     std::set<long> finished;
     for (std::size_t k = 1; k < order.size(); ++k) {
@@ -36,13 +34,36 @@ TEST(SpatialOrder, IsAPermutationGroupingEachCellContiguously) {
             ASSERT_TRUE(finished.insert(key(order[k - 1])).second);
         }
     }
-    // Stable within a cell: old indices ascend.
     for (std::size_t k = 1; k < order.size(); ++k)
         if (key(order[k - 1]) == key(order[k])) {
             EXPECT_LT(order[k - 1], order[k]);
         }
     const std::vector<int> inverse = dem::inversePermutation(order);
     for (std::size_t k = 0; k < order.size(); ++k) EXPECT_EQ(inverse[order[k]], static_cast<int>(k));
+}
+
+std::vector<Vec3> randomBox(const Vec3& extent, int count) {
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    std::vector<Vec3> x(count);
+    for (Vec3& p : x) p = Vec3(extent.x() * u(rng), extent.y() * u(rng), extent.z() * u(rng));
+    return x;
+}
+
+}  // namespace
+
+TEST(SpatialOrder, TallBoxKeepsZYXOrder) {
+    const std::vector<Vec3> x = randomBox(Vec3(0.3, 0.5, 1.0), 5000);
+    const std::vector<int> order = dem::spatialOrder(x, 0.1);
+    expectCellOrder(x, order, 0.1, [](long cx, long cy, long cz) { return (cz * 100 + cy) * 100 + cx; });
+}
+
+TEST(SpatialOrder, LongestAxisIsSlowestShortestFastest) {
+    // A bed wider than deep: x longest, then z, then y.  (With z slowest the
+    // first assertion of expectCellOrder fails.)
+    const std::vector<Vec3> x = randomBox(Vec3(1.0, 0.3, 0.6), 5000);
+    const std::vector<int> order = dem::spatialOrder(x, 0.1);
+    expectCellOrder(x, order, 0.1, [](long cx, long cy, long cz) { return (cx * 100 + cz) * 100 + cy; });
 }
 
 TEST(SpatialOrder, ScatteredParticlesDoNotBlowUpTheGrid) {

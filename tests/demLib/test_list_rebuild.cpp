@@ -218,4 +218,28 @@ TEST(ParticleParticleNeighborList, RebuildCarriesPairStateAndDoesNotDependOnThre
     }
 }
 
+// The pairs in contact at the build, per row (the force loop's cost estimate
+// for its thread split), against brute force; the same with 1 and 2 threads;
+// gone after a remap until the next build.
+TEST(ParticleParticleNeighborList, CountsTouchingPairsPerRowAtTheBuild) {
+    const dem::ParticleStore p = jitteredLattice(14, 0.5e-3, 0.08e-3, 11);
+    const int n = static_cast<int>(p.size());
+    std::vector<int> expected(n + 1, 0);
+    for (const auto& [i, j] : allPairs(p, 0.0)) ++expected[i + 1];
+    for (int i = 0; i < n; ++i) expected[i + 1] += expected[i];
+    ASSERT_GT(expected[n], n / 2);  // many contacts ...
+    ASSERT_LT(expected[n], static_cast<int>(allPairs(p, 0.2e-3).size()));  // ... fewer than listed pairs
+    for (int threads : {1, 2}) {
+        ThreadCount scope(threads);
+        dem::ParticleParticleNeighborList list;
+        list.setRanges(0.2e-3, 0.0);
+        list.build(p);
+        EXPECT_EQ(list.touchingOffsets(), expected) << threads << " thread(s)";
+        std::vector<int> identity(n);
+        for (int i = 0; i < n; ++i) identity[i] = i;
+        list.remap(identity);
+        EXPECT_TRUE(list.touchingOffsets().empty());
+    }
+}
+
 }  // namespace

@@ -20,15 +20,26 @@ struct InverseMass {
     }
 };
 
-// The one loop behind the three entry points: `kicks` half kicks with the
-// same force and torque (two = the closing kick of a step and the opening
-// kick of the next), then the drift if asked.  Each half kick is its own
+// The body force: weight plus the external (fluid) force where a coupling set one.
+inline Vec3 bodyForce(const ParticleStore& p, std::size_t i, const Vec3& g, bool external) {
+    return external ? Vec3(p.mass[i] * g + p.externalForce[i]) : Vec3(p.mass[i] * g);
+}
+
+// The one loop behind the entry points: `kicks` half kicks with the same force
+// and torque (two = the closing kick of a step and the opening kick of the
+// next), then the drift if asked, then the extras.  Each half kick is its own
 // addition, so kicks = 2 rounds exactly like two separate calls.
-template <int kicks, bool drift>
-void advance(ParticleStore& p, double dt, std::size_t count) {
+template <int kicks, bool drift, bool watch, bool reset>
+bool advance(ParticleStore& p, double dt, std::size_t count, const DriftExtras& extras) {
     const double half = 0.5 * dt;
     const std::size_t n = std::min(count, p.size());
-#pragma omp parallel for schedule(static) num_threads(threadsFor(n, lightLoopParticlesPerThread))
+    const Vec3* from = extras.displacementFrom;
+    const double limit2 = extras.limitSquared;
+    const Vec3 g = extras.gravity;
+    const ParticleStore& cp = p;  // reads of externalForce must not allocate it
+    const bool external = cp.externalForce.allocated();
+    bool moved = false;
+#pragma omp parallel for schedule(static) reduction(|| : moved) num_threads(threadsFor(n, lightLoopParticlesPerThread))
     for (std::size_t i = 0; i < n; ++i) {
         const InverseMass inv(p.mass[i], p.radius[i]);
         const Vec3 dv = (half * inv.mass) * p.force[i];
@@ -38,14 +49,50 @@ void advance(ParticleStore& p, double dt, std::size_t count) {
             p.omega[i] += dw;
         }
         if constexpr (drift) p.position[i] += dt * p.velocity[i];
+        if constexpr (watch) moved = moved || (p.position[i] - from[i]).squaredNorm() > limit2;
+        if constexpr (reset) {
+            p.force[i] = bodyForce(cp, i, g, external);
+            p.torque[i].setZero();
+        }
     }
+    return moved;
+}
+
+template <int kicks>
+bool advanceWith(ParticleStore& p, double dt, std::size_t count, const DriftExtras& e) {
+    const bool watch = e.displacementFrom != nullptr;
+    if (watch && e.resetForces) return advance<kicks, true, true, true>(p, dt, count, e);
+    if (watch) return advance<kicks, true, true, false>(p, dt, count, e);
+    if (e.resetForces) return advance<kicks, true, false, true>(p, dt, count, e);
+    return advance<kicks, true, false, false>(p, dt, count, e);
 }
 }  // namespace
 
-void kickAndDrift(ParticleStore& p, double dt, std::size_t count) { advance<1, true>(p, dt, count); }
+void kickAndDrift(ParticleStore& p, double dt, std::size_t count) { advance<1, true, false, false>(p, dt, count, {}); }
 
-void kick(ParticleStore& p, double dt, std::size_t count) { advance<1, false>(p, dt, count); }
+void kick(ParticleStore& p, double dt, std::size_t count) { advance<1, false, false, false>(p, dt, count, {}); }
 
-void kickKickAndDrift(ParticleStore& p, double dt, std::size_t count) { advance<2, true>(p, dt, count); }
+void kickKickAndDrift(ParticleStore& p, double dt, std::size_t count) {
+    advance<2, true, false, false>(p, dt, count, {});
+}
+
+bool kickAndDrift(ParticleStore& p, double dt, std::size_t count, const DriftExtras& e) {
+    return advanceWith<1>(p, dt, count, e);
+}
+
+bool kickKickAndDrift(ParticleStore& p, double dt, std::size_t count, const DriftExtras& e) {
+    return advanceWith<2>(p, dt, count, e);
+}
+
+void resetForces(ParticleStore& p, const Vec3& g) {
+    const std::size_t n = p.size();
+    const ParticleStore& cp = p;
+    const bool external = cp.externalForce.allocated();
+#pragma omp parallel for schedule(static) num_threads(threadsFor(n, lightLoopParticlesPerThread))
+    for (std::size_t i = 0; i < n; ++i) {
+        p.force[i] = bodyForce(cp, i, g, external);
+        p.torque[i].setZero();
+    }
+}
 
 }  // namespace dem

@@ -33,7 +33,7 @@ void ParticleParticleNeighborList::setRanges(double skin, double extraRange) {
 
 bool ParticleParticleNeighborList::needsRebuild(const ParticleStore& particles) const {
     if (positionAtBuild_.size() != particles.size()) return true;
-    const double limit2 = 0.25 * skin_ * skin_;
+    const double limit2 = rebuildDisplacementSquared();
     const std::size_t n = particles.size();
     bool rebuild = false;
 #pragma omp parallel for schedule(static) reduction(|| : rebuild) num_threads(threadsFor(n, lightLoopParticlesPerThread))
@@ -92,6 +92,7 @@ void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
         bridgeVolume_.clear();
     }
     std::vector<int> newOffsets(n + 1, 0);
+    touchingOffsets_.assign(n + 1, 0);
     if (n == 0) {
         offsets_.swap(newOffsets);
         neighbors_.clear();
@@ -126,6 +127,7 @@ void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
     const double* oldBridge = bridgeVolume_.data();
     const bool keepBridges = fields_.bridgeVolume;
     const int transferRows = canTransfer ? oldN : 0;
+    int* touchingCount = touchingOffsets_.data() + 1;
 #pragma omp parallel num_threads(threads)
     {
 #ifdef _OPENMP
@@ -152,6 +154,7 @@ void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
         std::vector<int>& mine = out.row;
         for (int i = begin; i < end; ++i) {
             mine.clear();
+            int touching = 0;
             const int c = cellOf[i];
             const int cx = c % nx, cy = (c / nx) % ny, cz = c / (nx * ny);
             const Vec3& xi = positions[i];
@@ -169,14 +172,18 @@ void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
                         for (int k = cellStart[cc]; k < cellStart[cc + 1]; ++k) {
                             const int j = cellParticles[k];
                             if (j <= i) continue;
-                            const double range = ri + particles.radius[j] + reach;
-                            if ((positions[j] - xi).squaredNorm() < range * range) mine.push_back(j);
+                            const double contact = ri + particles.radius[j];
+                            const double range = contact + reach;
+                            const double dist2 = (positions[j] - xi).squaredNorm();
+                            if (dist2 < range * range) mine.push_back(j);
+                            touching += dist2 < contact * contact;
                         }
                     }
                 }
             }
             std::sort(mine.begin(), mine.end());
             newOffsets[i + 1] = static_cast<int>(mine.size());
+            touchingCount[i] = touching;
             int a = i < transferRows ? oldOffsets[i] : 0;
             const int aEnd = i < transferRows ? oldOffsets[i + 1] : 0;
             for (const int j : mine) {
@@ -200,7 +207,10 @@ void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
     std::vector<int>().swap(bins.cellOf);
     std::vector<int>().swap(bins.cellStart);
     std::vector<int>().swap(bins.particles);
-    for (int i = 0; i < n; ++i) newOffsets[i + 1] += newOffsets[i];
+    for (int i = 0; i < n; ++i) {
+        newOffsets[i + 1] += newOffsets[i];
+        touchingOffsets_[i + 1] += touchingOffsets_[i];
+    }
     offsets_.swap(newOffsets);
     std::vector<int>().swap(newOffsets);
 
@@ -232,6 +242,7 @@ void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
 }
 
 void ParticleParticleNeighborList::remap(const std::vector<int>& oldToNew) {
+    touchingOffsets_.clear();  // rows moved: known again at the next build
     const int oldN = static_cast<int>(offsets_.size()) - 1;
     int newN = 0;
     for (int k : oldToNew) newN = std::max(newN, k + 1);
@@ -283,7 +294,7 @@ void ParticleParticleNeighborList::remap(const std::vector<int>& oldToNew) {
 }
 
 std::size_t ParticleParticleNeighborList::bytes() const {
-    return offsets_.capacity() * sizeof(int) + neighbors_.capacity() * sizeof(int) +
+    return (offsets_.capacity() + neighbors_.capacity() + touchingOffsets_.capacity()) * sizeof(int) +
            history_.bytes() + bridgeVolume_.capacity() * sizeof(double) + positionAtBuild_.capacity() * sizeof(Vec3) +
            buildBufferBytes();
 }

@@ -376,16 +376,8 @@ void Simulation::redistributeLiquid(double wallReach) {
     liquid_.poolVolume = d.freeLiquid;
 }
 
-void Simulation::computeForces() {
-    const std::size_t n = particles_.size();
-    const Vec3 g = settings_.gravity;
-    const ParticleStore& p = particles_;  // reads of externalForce must not allocate it
-    const bool external = p.externalForce.allocated();
-#pragma omp parallel for schedule(static) num_threads(threadsFor(n, lightLoopParticlesPerThread))
-    for (std::size_t i = 0; i < n; ++i) {
-        particles_.force[i] = external ? Vec3(p.mass[i] * g + p.externalForce[i]) : Vec3(p.mass[i] * g);
-        particles_.torque[i].setZero();
-    }
+void Simulation::computeForces(bool forcesReset) {
+    if (!forcesReset) resetForces(particles_, settings_.gravity);
     last_.contacts = kernel_->compute(particles_, pairs_, wallContacts_, walls_, wallCandidates_, interactions_,
                                       time_, settings_.timeStep);
     if (liquidNetwork_) {
@@ -399,29 +391,55 @@ void Simulation::step(long steps) {
     const double dt = settings_.timeStep;
     // Within one call the closing half kick of a step and the opening half kick
     // and drift of the next are one pass over the particles (same arithmetic).
+    // Without MPI that pass also tests the displacement since the list build
+    // and resets the forces to the body force: the particles pass through the
+    // cache once per step instead of three times.  (With MPI the test also
+    // covers the ghosts and the reset their forces, so the loops stay apart.)
+    const bool fused = !decomposition_;
+    // Read just before each drift: a rebuild replaces the positions at build.
+    auto driftExtras = [&]() {
+        DriftExtras extras;
+        if (fused && pairs_.positionsAtBuild().size() == particles_.size()) {
+            extras.displacementFrom = pairs_.positionsAtBuild().data();
+            extras.limitSquared = pairs_.rebuildDisplacementSquared();
+        }
+        extras.resetForces = fused;
+        extras.gravity = settings_.gravity;
+        return extras;
+    };
     bool drifted = false;
+    bool watched = false;   // the drift did the rebuild test ...
+    bool movedFar = false;  // ... with this result
+    bool forcesReset = false;
+    auto drift = [&](bool twoKicks) {
+        const DriftExtras extras = driftExtras();
+        movedFar = twoKicks ? kickKickAndDrift(particles_, dt, ownedCount(), extras)
+                            : kickAndDrift(particles_, dt, ownedCount(), extras);
+        watched = extras.displacementFrom != nullptr;
+        forcesReset = extras.resetForces;
+    };
     for (long s = 0; s < steps; ++s) {
         if (!forcesValid_) {
             updatePairList();
-            computeForces();
+            computeForces(false);
             forcesValid_ = true;
         }
-        if (!drifted) kickAndDrift(particles_, dt, ownedCount());
+        if (!drifted) drift(false);
         ++step_;
         // Time from the step count: no drift from summing dt, exact on restart.
         time_ = step_ * dt;
         removeLostParticles();
-        bool rebuild = last_.lostThisStep > 0 || pairs_.needsRebuild(particles_);
+        bool rebuild = last_.lostThisStep > 0 || (watched ? movedFar : pairs_.needsRebuild(particles_));
         if (decomposition_) {
             // All ranks rebuild together (the rebuild exchanges particles).
             rebuild = decomposition_->communicator().anyTrue(rebuild);
             if (!rebuild) decomposition_->updateGhosts(particles_);
         }
         if (rebuild) updatePairList();
-        computeForces();
+        computeForces(forcesReset);
         drifted = s + 1 < steps;
         if (drifted)
-            kickKickAndDrift(particles_, dt, ownedCount());
+            drift(true);  // with the next step's list test and force reset
         else
             kick(particles_, dt, ownedCount());
     }

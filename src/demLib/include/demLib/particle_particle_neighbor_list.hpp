@@ -81,7 +81,11 @@ public:
     double skin() const { return skin_; }
     double extraRange() const { return extraRange_; }
 
+    // True when a particle has moved more than skin/2 since the last build
+    // (then a pair may have come into range unseen), or the count changed.
     bool needsRebuild(const ParticleStore& particles) const;
+    // (skin/2)^2: the squared displacement needsRebuild tests against.
+    double rebuildDisplacementSquared() const { return 0.25 * skin_ * skin_; }
 
     // Rebuilds the list from the current positions; pair state of pairs that
     // stay neighbours is kept.  Deterministic for any thread count.
@@ -106,6 +110,12 @@ public:
     const std::vector<double>& bridgeVolume() const { return bridgeVolume_; }
     PairStateView state() const { return PairStateView(history_, bridgeVolume_); }
     const std::vector<Vec3>& positionsAtBuild() const { return positionAtBuild_; }
+    // Pairs in contact at the last build, as a prefix over the rows (like
+    // offsets(): rows before i hold touchingOffsets()[i] of them); the force
+    // loop weighs its split of the rows between threads with it.  Empty after
+    // remap() until the next build.  A function of the positions at build, so
+    // a restart reproduces it.
+    const std::vector<int>& touchingOffsets() const { return touchingOffsets_; }
     std::size_t pairCount() const { return neighbors_.size(); }
     long buildCount() const { return buildCount_; }
 
@@ -141,6 +151,7 @@ private:
     double extraRange_ = 0.0;
     std::vector<int> offsets_{0};
     std::vector<int> neighbors_;
+    std::vector<int> touchingOffsets_;
     PairStateFields fields_;
     ContactHistoryPool history_;
     std::vector<double> bridgeVolume_;

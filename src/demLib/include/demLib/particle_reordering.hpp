@@ -10,7 +10,9 @@
 namespace dem {
 
 // The permutation that sorts the particles by the cell (of the given size) that
-// holds their centre, cells in z-y-x row-major order; stable within a cell.
+// holds their centre, cells in row-major order with the axis of most cells
+// slowest and that of fewest fastest (ties: z before y before x); stable
+// within a cell.
 // order[k] is the old index of the particle that goes to index k.
 std::vector<int> spatialOrder(const std::vector<Vec3>& positions, double cellSize);
 

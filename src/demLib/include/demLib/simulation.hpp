@@ -154,7 +154,8 @@ private:
     // records (sorted, history of the current list carried) and their gaps.
     void wallBridgeCandidates(double reach, std::vector<WallContactRecord>& records,
                               std::vector<double>& gaps) const;
-    void computeForces();
+    // forcesReset: F = m g + F_external and T = 0 are set already (by the drift).
+    void computeForces(bool forcesReset);
     void requireNoDecomposition(const std::string& what) const;
 
     SimulationSettings settings_;
