@@ -495,6 +495,7 @@ private:
         const bool bridges = capillary && settings_.wallBridges;
         const double reach = bridges ? old.bridgeReach() : 0.0;
         WallProximityQuery query(walls, time);
+        ParticleWallContacts::Cursor previous(old, begin);
         for (int i = begin; i < end; ++i) {
             const std::size_t first = out.size();
             const Vec3 xi = p.position[i];
@@ -509,7 +510,7 @@ private:
                 rec.particle = i;
                 rec.wall = w;
                 rec.feature = c.feature;
-                const WallContactRecord* prev = old.find(i, w, c.feature);
+                const WallContactRecord* prev = previous.find(i, w, c.feature);
                 double cohesiveForce = 0.0;
                 if (bridges && prev) {
                     // The sphere-wall bridge as the pair bridge of capillaryForceSphereWall.

@@ -14,6 +14,16 @@ const WallContactRecord* ParticleWallContacts::find(int particle, int wall, int 
     return &*it;
 }
 
+ParticleWallContacts::Cursor::Cursor(const ParticleWallContacts& contacts, int firstParticle)
+    : records_(contacts.records_), at_(contacts.rangeOf(firstParticle).first) {}
+
+const WallContactRecord* ParticleWallContacts::Cursor::find(int particle, int wall, int feature) {
+    while (at_ < records_.size() && records_[at_].particle < particle) ++at_;
+    for (std::size_t k = at_; k < records_.size() && records_[k].particle == particle; ++k)
+        if (records_[k].wall == wall && records_[k].feature == feature) return &records_[k];
+    return nullptr;
+}
+
 std::pair<std::size_t, std::size_t> ParticleWallContacts::rangeOf(int particle) const {
     const auto byParticle = [](const WallContactRecord& r, int p) { return r.particle < p; };
     const auto first = std::lower_bound(records_.begin(), records_.end(), particle, byParticle);

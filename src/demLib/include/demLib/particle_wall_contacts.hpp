@@ -41,6 +41,18 @@ public:
     // Index range [first, second) of the records of one particle.
     std::pair<std::size_t, std::size_t> rangeOf(int particle) const;
 
+    // find() for particles visited in increasing order (the wall loop): the
+    // records are walked forward once instead of searched per contact.
+    class Cursor {
+    public:
+        Cursor(const ParticleWallContacts& contacts, int firstParticle);
+        const WallContactRecord* find(int particle, int wall, int feature);
+
+    private:
+        const std::vector<WallContactRecord>& records_;
+        std::size_t at_;  // first record of a particle >= the last one asked for
+    };
+
     std::vector<WallContactRecord>& records() { return records_; }
     const std::vector<WallContactRecord>& records() const { return records_; }
 
