@@ -410,13 +410,11 @@ void Simulation::step(long steps) {
     bool drifted = false;
     bool watched = false;   // the drift did the rebuild test ...
     bool movedFar = false;  // ... with this result
-    bool forcesReset = false;
     auto drift = [&](bool twoKicks) {
         const DriftExtras extras = driftExtras();
         movedFar = twoKicks ? kickKickAndDrift(particles_, dt, ownedCount(), extras)
                             : kickAndDrift(particles_, dt, ownedCount(), extras);
         watched = extras.displacementFrom != nullptr;
-        forcesReset = extras.resetForces;
     };
     for (long s = 0; s < steps; ++s) {
         if (!forcesValid_) {
@@ -436,7 +434,7 @@ void Simulation::step(long steps) {
             if (!rebuild) decomposition_->updateGhosts(particles_);
         }
         if (rebuild) updatePairList();
-        computeForces(forcesReset);
+        computeForces(fused);  // a drift (this step's or the last one's) came first
         drifted = s + 1 < steps;
         if (drifted)
             drift(true);  // with the next step's list test and force reset
