@@ -368,6 +368,73 @@ TEST(EngineCapillary, RestartWithWallBridgesIsBitwiseIdentical) {
     std::remove(path.c_str());
 }
 
+// The bridge listing limit (SimulationSettings::bridgeListingMargin) leaves
+// out of the list only pairs that cannot touch before the next build and hold
+// no bridge: the run is bitwise that of the whole range, while the list is
+// much shorter.  Margin 1 relists whenever the liquid per weight grows at all
+// (the path that keeps the limit safe); it must change nothing either.  One
+// thread: a different list length moves a second thread's share of the rows.
+// A wet pour of F32 x 5 (0.45-2.1 mm) onto a floor that slides, then drops
+// away (particles leave, bridges break: the liquid per weight rises).
+dem::Simulation wetPolydisperseBox(double margin) {
+    dem::SimulationSettings s = capillarySettings(4e-6, Vec3(0, 0, -9.81));
+    s.bridgeListingMargin = margin;
+    s.forces.rolling = dem::RollingModel::EPSD2;
+    s.domain = dem::AxisAlignedBox{Vec3(-0.001, -0.001, -0.002), Vec3(0.013, 0.013, 0.04)};
+    dem::WallMotion floor;
+    floor.addTranslation(0.0, 0.05, Vec3(0.02, 0, 0));
+    floor.addTranslation(0.05, 0.06, Vec3(0, 0, -1.0));
+    dem::Simulation sim = makeSimulation(s, openBox(0.012, 0.04, floor));
+    pourInto(sim, 0.012, 0.03, 250, 3);
+    sim.setWaterContent(0.05);
+    return sim;
+}
+
+TEST(EngineCapillary, BridgeListingLimitShortensTheListNotTheRun) {
+    ThreadCount threads(1);
+    constexpr long steps = 20000, every = 50;  // 0.08 s
+    std::vector<dem::Simulation> runs;
+    for (double margin : {0.0, 1.5, 1.0}) runs.push_back(wetPolydisperseBox(margin));
+    // Compared at every checkpoint: particles, liquid, list builds.
+    auto sameAsWholeRange = [&](const dem::Simulation& b) {
+        const dem::Simulation& a = runs[0];
+        if (a.particles().size() != b.particles().size()) return false;
+        for (std::size_t i = 0; i < a.particles().size(); ++i)
+            if (!(a.particles().position[i] == b.particles().position[i]) ||
+                !(a.particles().velocity[i] == b.particles().velocity[i]) ||
+                !(a.particles().omega[i] == b.particles().omega[i]))
+                return false;
+        return a.liquid().poolVolume == b.liquid().poolVolume && a.liquidInBridges() == b.liquidInBridges() &&
+               a.liquid().bridgeCount == b.liquid().bridgeCount &&
+               a.pairList().buildCount() == b.pairList().buildCount();
+    };
+    std::vector<double> listed(runs.size(), 0.0);
+    std::vector<long> differingCheckpoints(runs.size(), 0);
+    std::size_t bridgesSeen = 0, particlesAtSlideEnd = 0;
+    for (long n = every; n <= steps; n += every) {
+        for (std::size_t r = 0; r < runs.size(); ++r) {
+            runs[r].step(every);
+            listed[r] += static_cast<double>(runs[r].pairList().pairCount());
+            if (r > 0 && !sameAsWholeRange(runs[r])) ++differingCheckpoints[r];
+        }
+        bridgesSeen = std::max(bridgesSeen, runs[0].liquid().bridgeCount);
+        if (n == 12500) particlesAtSlideEnd = runs[0].particles().size();
+    }
+    std::printf("bridge listing: listed pairs summed over checkpoints %.0f (whole range), %.0f (margin 1.5), "
+                "%.0f (margin 1); relists %ld / %ld of %ld builds; max %zu bridges; %zu particles at the end "
+                "of the slide, %zu at the end\n",
+                listed[0], listed[1], listed[2], runs[1].bridgeRelistCount(), runs[2].bridgeRelistCount(),
+                runs[1].pairList().buildCount(), bridgesSeen, particlesAtSlideEnd, runs[0].particles().size());
+    ASSERT_GT(bridgesSeen, 200u);
+    EXPECT_EQ(particlesAtSlideEnd, 250u);
+    EXPECT_LT(runs[0].particles().size(), 125u);  // the floor dropped: particles left, λ rose
+    EXPECT_EQ(differingCheckpoints[1], 0);
+    EXPECT_EQ(differingCheckpoints[2], 0);
+    EXPECT_LT(listed[1], 0.5 * listed[0]);
+    EXPECT_EQ(runs[0].bridgeRelistCount(), 0);  // no limit, nothing to relist
+    EXPECT_GT(runs[2].bridgeRelistCount(), 10);  // margin 1: λ grew at many builds
+}
+
 // ---------------------------------------------------------------------------
 // 3. Liquid coordination number z of wet beds at w = 0.05 (paper §5: z = 8,
 // "the highest possible value", all pairs within the debonding distance).

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <random>
 #include <set>
@@ -15,6 +16,7 @@
 #include <vector>
 
 #include "demLib/contact_history_pool.hpp"
+#include "demLib/liquid_bridges.hpp"
 #include "demLib/particle_particle_neighbor_list.hpp"
 #include "contact_history_testing.hpp"
 #include "thread_count.hpp"
@@ -239,6 +241,50 @@ TEST(ParticleParticleNeighborList, CountsTouchingPairsPerRowAtTheBuild) {
         for (int i = 0; i < n; ++i) identity[i] = i;
         list.remap(identity);
         EXPECT_TRUE(list.touchingOffsets().empty());
+    }
+}
+
+// With a bridge listing limit λ_max, a pair beyond touching reach (gap >=
+// skin) but within the extra range is listed iff a bridge could hold between
+// its particles at λ_max (λ*_k <= λ_max), against brute force; pairs within
+// touching reach are always listed.  Polydisperse jittered lattice (radii
+// 0.5, 0.6, 0.7 mm).
+TEST(ParticleParticleNeighborList, ListsPairsBeyondTouchingReachOnlyWhereABridgeCanHold) {
+    const dem::ParticleStore p = jitteredLattice(12, 0.5e-3, 0.1e-3, 5);
+    const double skin = 0.05e-3, extra = 0.6e-3;
+    dem::LiquidBridgeSettings bridges;
+    bridges.contactAngle = 0.3;
+    // λ* of a pair 0.2 mm apart with radii 0.5 and 0.6 mm: pairs closer or
+    // smaller-gapped per weight pass, the wider ones (up to 0.65 mm) do not.
+    const double limit = dem::bridgeStabilityThreshold(0.5e-3, 0.6e-3, 1.3e-3, bridges);
+    std::vector<std::pair<int, int>> expected;
+    std::size_t beyondTouching = 0, withinRange = 0;
+    for (const auto& [i, j] : allPairs(p, skin + extra)) {
+        ++withinRange;
+        const double distance = (p.position[j] - p.position[i]).norm();
+        const double touchingReach = p.radius[i] + p.radius[j] + skin;
+        if (distance < touchingReach) {
+            expected.emplace_back(i, j);
+        } else if (dem::bridgeStabilityThreshold(p.radius[i], p.radius[j], distance, bridges) <= limit) {
+            expected.emplace_back(i, j);
+            ++beyondTouching;
+        }
+    }
+    // The limit must cut: some pairs beyond touching reach in, many out.
+    ASSERT_GT(beyondTouching, 100u);
+    ASSERT_LT(expected.size() + 1000, withinRange);
+    for (int threads : {1, 2}) {
+        ThreadCount scope(threads);
+        dem::ParticleParticleNeighborList list;
+        list.setRanges(skin, extra);
+        list.setBridgeListing(bridges, limit);
+        list.build(p);
+        EXPECT_EQ(listedPairs(list), expected) << threads << " thread(s)";
+        // No limit: the whole range again, from the same build positions.
+        list.setBridgeListing(bridges, std::numeric_limits<double>::infinity());
+        list.relistAtBuildPositions(p);
+        EXPECT_EQ(listedPairs(list), allPairs(p, skin + extra)) << threads << " thread(s)";
+        EXPECT_EQ(list.buildCount(), 1);
     }
 }
 

@@ -233,7 +233,9 @@ private:
                        double& releasedLiquid) const {
         if (!(volume > 0.0)) return 0.0;
         const double gap = -overlap;
-        if (gap > debondingDistance(volume, settings_.capillary.contactAngle)) {
+        // In contact (gap <= 0) a bridge cannot exceed its debonding distance:
+        // the cube root is only taken for bridges across a gap.
+        if (gap > 0.0 && gap > debondingDistance(volume, settings_.capillary.contactAngle)) {
             releasedLiquid += volume;  // back to the free liquid
             volume = 0.0;
             return 0.0;

@@ -138,6 +138,7 @@ std::int64_t Hdf5File::intAttribute(const std::string& name) const {
     readAttribute(file_, path_, name, H5T_NATIVE_INT64, &v);
     return v;
 }
+bool Hdf5File::hasAttribute(const std::string& name) const { return H5Aexists(file_, name.c_str()) > 0; }
 std::string Hdf5File::stringAttribute(const std::string& name) const {
     Handle attr{H5Aopen(file_, name.c_str(), H5P_DEFAULT), H5Aclose};
     if (attr.id < 0) fail(path_, "missing attribute '" + name + "'");

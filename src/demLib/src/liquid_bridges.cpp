@@ -83,6 +83,14 @@ double bridgeVolumeWeight(double radiusOfA, double radiusOfB, double distanceOfC
     return 0.0;  // unreachable: every enumerator is handled above
 }
 
+double bridgeStabilityThreshold(double radiusOfA, double radiusOfB, double distanceOfCentres,
+                                const LiquidBridgeSettings& settings) {
+    const double gap = distanceOfCentres - radiusOfA - radiusOfB;
+    const double scaledGap = std::max(gap, 0.0) / (1.0 + 0.5 * settings.contactAngle);
+    return scaledGap * scaledGap * scaledGap /
+           bridgeVolumeWeight(radiusOfA, radiusOfB, distanceOfCentres, settings.weight);
+}
+
 LiquidBridgeNetwork::LiquidBridgeNetwork(double totalLiquidVolume, const LiquidBridgeSettings& settings)
     : totalLiquid_(totalLiquidVolume), settings_(settings) {
     if (!(totalLiquidVolume >= 0.0) || !std::isfinite(totalLiquidVolume))
@@ -112,7 +120,6 @@ const BridgeDistribution& LiquidBridgeNetwork::update(const BridgeCandidates& ca
 
     // λ*_k: the liquid per unit weight at which pair k's own bridge reaches its
     // debonding distance, gap_k = (1+θ/2)(λ w_k)^(1/3).  Overlapping pairs: 0.
-    const double debondingPrefactor = 1.0 + 0.5 * settings_.contactAngle;
     for (std::size_t k = 0; k < pairCount; ++k) {
         const double ra = candidates.radiusA[k];
         const double rb = candidates.radiusB[k];
@@ -123,8 +130,7 @@ const BridgeDistribution& LiquidBridgeNetwork::update(const BridgeCandidates& ca
         const double gap = distance - ra - rb;
         if (persistent && gap > 0.0 && !candidates.wasBonded[k]) continue;  // no contact, no bridge yet
         weight_[k] = bridgeVolumeWeight(ra, rb, distance, settings_.weight);
-        const double scaledGap = std::max(gap, 0.0) / debondingPrefactor;
-        stabilityThreshold_[k] = scaledGap * scaledGap * scaledGap / weight_[k];
+        stabilityThreshold_[k] = bridgeStabilityThreshold(ra, rb, distance, settings_);
         if (stabilityThreshold_[k] > 0.0)
             separatedPairs_.emplace_back(stabilityThreshold_[k], k);
         else
@@ -169,6 +175,7 @@ const BridgeDistribution& LiquidBridgeNetwork::update(const BridgeCandidates& ca
     distribution_.bondCount = acceptedCount;
     distribution_.bondedLiquid = bondedLiquid.value();
     distribution_.freeLiquid = acceptedCount > 0 ? 0.0 : totalLiquid_;
+    distribution_.liquidPerWeight = liquidPerWeight;
     return distribution_;
 }
 

@@ -31,6 +31,15 @@ void ParticleParticleNeighborList::setRanges(double skin, double extraRange) {
     extraRange_ = extraRange;
 }
 
+void ParticleParticleNeighborList::setBridgeListing(const LiquidBridgeSettings& settings, double liquidPerWeightLimit) {
+    bridgeSettings_ = settings;
+    bridgeListingLimit_ = liquidPerWeightLimit;
+}
+
+void ParticleParticleNeighborList::relistAtBuildPositions(const ParticleStore& particles, std::size_t listedRows) {
+    buildFrom(particles, positionAtBuild_, listedRows);
+}
+
 bool ParticleParticleNeighborList::needsRebuild(const ParticleStore& particles) const {
     if (positionAtBuild_.size() != particles.size()) return true;
     const double limit2 = rebuildDisplacementSquared();
@@ -121,6 +130,7 @@ void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
     const int threads = threadsFor(rows, heavyLoopParticlesPerThread);
     blocks_.resize(threads);
     const double reach = skin_ + extraRange_;
+    const bool filterBridges = extraRange_ > 0.0 && bridgeListingLimit_ < std::numeric_limits<double>::infinity();
     const int* oldOffsets = offsets_.data();
     const int* oldNeighbors = neighbors_.data();
     const int* oldSlots = history_.slots();
@@ -172,11 +182,18 @@ void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
                         for (int k = cellStart[cc]; k < cellStart[cc + 1]; ++k) {
                             const int j = cellParticles[k];
                             if (j <= i) continue;
-                            const double contact = ri + particles.radius[j];
+                            const double rj = particles.radius[j];
+                            const double contact = ri + rj;
                             const double range = contact + reach;
                             const double dist2 = (positions[j] - xi).squaredNorm();
-                            if (dist2 < range * range) mine.push_back(j);
                             touching += dist2 < contact * contact;
+                            if (!(dist2 < range * range)) continue;
+                            // Beyond touching reach: only where a bridge can hold.
+                            const double touchingRange = contact + skin_;
+                            if (filterBridges && !(dist2 < touchingRange * touchingRange) &&
+                                !(bridgeStabilityThreshold(ri, rj, std::sqrt(dist2), bridgeSettings_) <= bridgeListingLimit_))
+                                continue;
+                            mine.push_back(j);
                         }
                     }
                 }

@@ -162,6 +162,7 @@ void Simulation::setWaterContent(double w) {
     liquidNetwork_ = std::make_unique<LiquidBridgeNetwork>(volume, settings_.bridges);
     pairs_.setStateFields({pairs_.stateFields().rollingTorque, true});
     largestBridge_ = 0.0;
+    bridgeListingLimit_ = std::numeric_limits<double>::infinity();  // λ unknown for the new total
     forcesValid_ = false;
 }
 
@@ -277,6 +278,18 @@ void Simulation::updatePairList() {
         wallContacts_.remap(oldToNew);
     }
     pairs_.setRanges(skin, extra);
+    // Bridges form at the list build between pairs within their debonding
+    // distance at the liquid per weight λ that the distribution then finds;
+    // λ changes little between builds, so only pairs that could hold a bridge
+    // at bridgeListingMargin times the last λ are listed beyond touching reach
+    // (in a polydisperse wet bed the range of the largest bridge lists 3x
+    // more pairs).  Should the new λ exceed the limit, the list is made again
+    // without it (below): the results never depend on it.  (Bridges formed at
+    // contact only, and MPI runs, list the whole range.)
+    const bool limitBridgePairs = liquidNetwork_ && !decomposition_ &&
+                                  settings_.bridges.formation == BridgeFormation::WithinDebondingDistance;
+    pairs_.setBridgeListing(settings_.bridges,
+                            limitBridgePairs ? bridgeListingLimit_ : std::numeric_limits<double>::infinity());
     if (decomposition_) {
         // A listed pair is closer than r_i + r_j + skin + extra <= 2 r_max +
         // skin + extra: ghosts out to that distance from the slab suffice.
@@ -286,7 +299,19 @@ void Simulation::updatePairList() {
     } else {
         pairs_.build(particles_);
     }
-    if (liquidNetwork_) redistributeLiquid(extra);
+    if (liquidNetwork_) {
+        double liquidPerWeight = redistributeLiquid(extra);
+        // (With a margin for the rounding of λ = V / Σw against λ*_k Σw <= V.)
+        if (liquidPerWeight * (1.0 + 1e-9) > pairs_.bridgeListingLimit()) {
+            pairs_.setBridgeListing(settings_.bridges, std::numeric_limits<double>::infinity());
+            pairs_.relistAtBuildPositions(particles_);
+            ++bridgeRelists_;
+            liquidPerWeight = redistributeLiquid(extra);
+        }
+        bridgeListingLimit_ = liquidPerWeight > 0.0 && settings_.bridgeListingMargin > 0.0
+                                  ? settings_.bridgeListingMargin * liquidPerWeight
+                                  : std::numeric_limits<double>::infinity();
+    }
     rebuildWallCandidates();
 }
 
@@ -327,7 +352,7 @@ void Simulation::wallBridgeCandidates(double reach, std::vector<WallContactRecor
     }
 }
 
-void Simulation::redistributeLiquid(double wallReach) {
+double Simulation::redistributeLiquid(double wallReach) {
     BridgeCandidates candidates;
     const auto& offsets = pairs_.offsets();
     const auto& neighbors = pairs_.neighbors();
@@ -374,6 +399,7 @@ void Simulation::redistributeLiquid(double wallReach) {
             std::max(wallReach, debondingDistance(largestBridge_, settings_.bridges.contactAngle)));
     }
     liquid_.poolVolume = d.freeLiquid;
+    return d.liquidPerWeight;
 }
 
 void Simulation::computeForces(bool forcesReset) {

@@ -4,6 +4,7 @@
 // write never corrupts the previous restart file.
 #include <algorithm>
 #include <cstdio>
+#include <limits>
 #include <unordered_map>
 
 #include "demLib/error.hpp"
@@ -37,6 +38,8 @@ void Simulation::writeRestart(const std::string& path) const {
         f.setAttribute("bridgeCount", static_cast<std::int64_t>(liquid_.bridgeCount));
         f.setAttribute("hasLiquid", static_cast<std::int64_t>(liquidNetwork_ != nullptr));
         f.setAttribute("largestBridge", largestBridge_);
+        f.setAttribute("listBridgeListingLimit", pairs_.bridgeListingLimit());
+        f.setAttribute("nextBridgeListingLimit", bridgeListingLimit_);
         f.setAttribute("wallBridgeCount", static_cast<std::int64_t>(liquid_.wallBridgeCount));
         f.setAttribute("wallBridgeReach", wallContacts_.bridgeReach());
         f.setAttribute("listSkin", pairs_.skin());
@@ -177,6 +180,13 @@ void Simulation::readRestart(const std::string& path) {
     };
 
     pairs_.setRanges(f.doubleAttribute("listSkin"), f.doubleAttribute("listExtraRange"));
+    // Files from before the bridge listing limit: the whole range (the limit
+    // only leaves out pairs without a bridge, so the run continues the same).
+    constexpr double unlimited = std::numeric_limits<double>::infinity();
+    pairs_.setBridgeListing(settings_.bridges, f.hasAttribute("listBridgeListingLimit")
+                                                   ? f.doubleAttribute("listBridgeListingLimit") : unlimited);
+    bridgeListingLimit_ = f.hasAttribute("nextBridgeListingLimit") ? f.doubleAttribute("nextBridgeListingLimit")
+                                                                   : unlimited;
     pairs_.restore(particles_, f.readVec3("particles/positionAtListBuild"), f.intAttribute("listBuildCount"));
     const auto ids = f.readInt64("pairs/ids");
     const auto shear = f.readVec3("pairs/shear");

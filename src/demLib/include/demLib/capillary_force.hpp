@@ -42,12 +42,16 @@ struct CapillaryFitCoefficients {
     double C;
 };
 
+// Eqs 2-4 one by one (B and C take ln V*, computed once by the caller).
+inline double capillaryFitA(double reducedVolume) { return -1.1 * std::pow(reducedVolume, -0.53); }
+inline double capillaryFitB(double logReducedVolume, double contactAngle) {
+    return (-0.148 * logReducedVolume - 0.96) * (contactAngle * contactAngle) - 0.0082 * logReducedVolume + 0.48;
+}
+inline double capillaryFitC(double logReducedVolume) { return 0.0018 * logReducedVolume + 0.078; }
+
 inline CapillaryFitCoefficients capillaryFitCoefficients(double reducedVolume, double contactAngle) {
     const double logVolume = std::log(reducedVolume);
-    const double thetaSquared = contactAngle * contactAngle;
-    return {-1.1 * std::pow(reducedVolume, -0.53),
-            (-0.148 * logVolume - 0.96) * thetaSquared - 0.0082 * logVolume + 0.48,
-            0.0018 * logVolume + 0.078};
+    return {capillaryFitA(reducedVolume), capillaryFitB(logVolume, contactAngle), capillaryFitC(logVolume)};
 }
 
 // Eq 5: the gap beyond which the bridge of volume V_b is unstable and breaks.
@@ -63,10 +67,14 @@ inline double capillaryForceWithinReach(double radius1, double radius2, double g
     if (radius1 > radius2) std::swap(radius1, radius2);  // the fit is written for R1 ≤ R2
     const double largerRadius = radius2;
     const double reducedVolume = bridgeVolume / (largerRadius * largerRadius * largerRadius);
-    const CapillaryFitCoefficients fit = capillaryFitCoefficients(reducedVolume, parameters.contactAngle);
     const double reducedGap = gap / largerRadius;
-    const double shape = reducedGap > 0.0 ? std::exp(fit.A * reducedGap + fit.B) + fit.C
-                                          : std::exp(fit.B) + fit.C;
+    // Particles in contact (δ* ≤ 0) need only B and C: A's power is the
+    // costliest term of the fit, and most bridges of a dense wet bed are in contact.
+    const double logVolume = std::log(reducedVolume);
+    const double B = capillaryFitB(logVolume, parameters.contactAngle);
+    const double C = capillaryFitC(logVolume);
+    const double shape = reducedGap > 0.0 ? std::exp(capillaryFitA(reducedVolume) * reducedGap + B) + C
+                                          : std::exp(B) + C;
     return -capillary_detail::pi * parameters.surfaceTension * std::sqrt(radius1 * radius2) * shape;
 }
 

@@ -39,6 +39,7 @@ public:
     double doubleAttribute(const std::string& name) const;
     std::int64_t intAttribute(const std::string& name) const;
     std::string stringAttribute(const std::string& name) const;
+    bool hasAttribute(const std::string& name) const;
 
 private:
     std::string path_;

@@ -63,6 +63,7 @@ struct BridgeDistribution {
     std::size_t bondCount = 0;
     double bondedLiquid = 0.0;  // Σ volume, compensated sum
     double freeLiquid = 0.0;    // the pool: everything when no pair is bonded, else 0
+    double liquidPerWeight = 0.0;  // λ = V / Σ_bonded w (0: nothing bonded); V_k = λ w_k
     double totalLiquid() const { return bondedLiquid + freeLiquid; }
 };
 
@@ -77,6 +78,12 @@ double liquidCoordinationNumber(std::size_t bondCount, std::size_t particleCount
 // The sharing weight w_k of one pair.
 double bridgeVolumeWeight(double radiusOfA, double radiusOfB, double distanceOfCentres,
                           BridgeVolumeWeight weight);
+
+// λ*_k of a pair: the liquid per unit weight at which its bridge would just
+// reach its debonding distance, (max(gap, 0)/(1+θ/2))³ / w_k; a bridge holds
+// between the pair at liquid per weight λ iff λ ≥ λ*_k.
+double bridgeStabilityThreshold(double radiusOfA, double radiusOfB, double distanceOfCentres,
+                                const LiquidBridgeSettings& settings);
 
 // Holds the total liquid of the sample and re-distributes it each time the
 // engine updates its contact list.  Scratch storage is kept between updates,

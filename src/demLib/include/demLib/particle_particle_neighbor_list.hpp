@@ -5,10 +5,12 @@
 // pairs in a ContactHistoryPool, liquid bridge volumes in an array parallel to
 // the list) is carried over at rebuild.
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "demLib/contact_history_pool.hpp"
 #include "demLib/contact_law.hpp"
+#include "demLib/liquid_bridges.hpp"
 #include "demLib/particle_store.hpp"
 
 namespace dem {
@@ -74,6 +76,18 @@ public:
     // skin: absolute distance added to the contact range; extraRange: extra
     // interaction range beyond contact (capillary debonding distance).
     void setRanges(double skin, double extraRange);
+    // Pairs that cannot touch before the next build (gap >= skin) but lie
+    // within the extra range are listed only where a liquid bridge could hold
+    // at liquid per unit weight `liquidPerWeightLimit` (λ*_k <= limit, see
+    // bridgeStabilityThreshold): in a polydisperse wet bed the extra range of
+    // the largest bridge otherwise lists five times more pairs than touch.
+    // Infinity (the default) lists every pair within the extra range.
+    void setBridgeListing(const LiquidBridgeSettings& settings, double liquidPerWeightLimit);
+    double bridgeListingLimit() const { return bridgeListingLimit_; }
+    // Lists again from the positions at the last build (after a change of the
+    // bridge listing), keeping the pair state; not counted as a build.
+    void relistAtBuildPositions(const ParticleStore& particles,
+                                std::size_t listedRows = static_cast<std::size_t>(-1));
     // Which pair-state parts to keep (default: all).  Changing them drops or
     // zero-fills the affected arrays.
     void setStateFields(const PairStateFields& fields);
@@ -120,7 +134,8 @@ public:
     long buildCount() const { return buildCount_; }
 
     // Restart support: the list is a pure function of the positions at the last
-    // build, so restoring those and rebuilding reproduces it exactly.
+    // build (and the bridge listing limit, set before), so restoring those and
+    // rebuilding reproduces it exactly.
     void restore(const ParticleStore& particles, const std::vector<Vec3>& positionAtBuild,
                  long buildCount);
     // Installs saved pair state for pair (i, j), i < j, after restore(); parts
@@ -149,6 +164,8 @@ private:
 
     double skin_ = 0.0;
     double extraRange_ = 0.0;
+    LiquidBridgeSettings bridgeSettings_;
+    double bridgeListingLimit_ = std::numeric_limits<double>::infinity();
     std::vector<int> offsets_{0};
     std::vector<int> neighbors_;
     std::vector<int> touchingOffsets_;

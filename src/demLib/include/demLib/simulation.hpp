@@ -3,6 +3,7 @@
 // A Simulation owns the particles, the walls, the contact lists and the force
 // kernel, and advances them with velocity Verlet.
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -34,6 +35,12 @@ struct SimulationSettings {
     ForceFieldSettings forces;
     // Which pairs hold liquid bridges and how the water is shared (capillary only).
     LiquidBridgeSettings bridges;
+    // With capillary bridges, pairs that cannot touch before the next list
+    // build are listed only where a bridge could hold at this multiple of the
+    // last distribution's liquid per unit weight (see updatePairList); 0 lists
+    // every pair within the range of the largest bridge.  The results do not
+    // depend on it (a distribution beyond the limit lists again), the cost does.
+    double bridgeListingMargin = 1.5;
     // Verlet skin as a fraction of the largest particle diameter.
     double skinFraction = 0.2;
     // The time step must not exceed this fraction of the Rayleigh time of the
@@ -114,6 +121,9 @@ public:
     const std::vector<Material>& materials() const { return materials_; }
     const InteractionTable& interactions() const { return interactions_; }
     const ParticleParticleNeighborList& pairList() const { return pairs_; }
+    // List builds whose liquid distribution exceeded the bridge listing limit
+    // and were listed again without it (see SimulationSettings::bridgeListingMargin).
+    long bridgeRelistCount() const { return bridgeRelists_; }
     const ParticleWallContacts& wallContacts() const { return wallContacts_; }
     const StepStatistics& lastStep() const { return last_; }
     const LiquidState& liquid() const { return liquid_; }
@@ -149,7 +159,7 @@ private:
     void removeLostParticles();
     void updatePairList();
     void rebuildWallCandidates();
-    void redistributeLiquid(double wallReach);
+    double redistributeLiquid(double wallReach);  // returns λ, the liquid per unit weight
     // Walls within `reach` of each particle's surface at the current positions:
     // records (sorted, history of the current list carried) and their gaps.
     void wallBridgeCandidates(double reach, std::vector<WallContactRecord>& records,
@@ -176,6 +186,11 @@ private:
     LiquidState liquid_;
     std::unique_ptr<LiquidBridgeNetwork> liquidNetwork_;
     double largestBridge_ = 0.0;
+    // Liquid per unit weight up to which the next list build lists pairs
+    // beyond touching reach (bridgeListingMargin x the last distribution's;
+    // infinity: all within the bridge range).  See updatePairList.
+    double bridgeListingLimit_ = std::numeric_limits<double>::infinity();
+    long bridgeRelists_ = 0;
     StepStatistics last_;
     std::shared_ptr<GhostExchange> decomposition_;  // null: serial run
 };
