@@ -59,6 +59,12 @@ struct ForceSink {
     }
 };
 
+// A bridge's fit and the volume it was made for (-1: none yet).
+struct CachedBridgeFit {
+    double volume = -1.0;
+    CapillaryBridgeFit fit;
+};
+
 template <RollingModel Rolling, CohesionModel Cohesion>
 class ContactForceKernelImpl final : public ContactForceKernel {
 public:
@@ -126,6 +132,16 @@ public:
             return lo;
         };
 
+        // Bridge fits per list entry, forgotten when the list changes.
+        CachedBridgeFit* fits = nullptr;
+        if constexpr (Cohesion == CohesionModel::Capillary) {
+            if (fitsListVersion_ != pairs.version() || bridgeFits_.size() != pairs.pairCount()) {
+                bridgeFits_.assign(pairs.pairCount(), CachedBridgeFit{});
+                fitsListVersion_ = pairs.version();
+            }
+            fits = bridgeFits_.data();
+        }
+
 #pragma omp parallel num_threads(threads)
         {
             const int t = threadIndex();
@@ -142,9 +158,9 @@ public:
             ContactHistoryPool::Changes changes = std::move(changes_[t]);
             std::vector<WallContactRecord> wallRecords = std::move(newWall[t]);
             if (settings_.vectorizedPairLaw)
-                pairForcesBatched(p, pairs, interactions, dt, sink, localStats, changes, *batches_[t]);
+                pairForcesBatched(p, pairs, interactions, dt, sink, localStats, changes, *batches_[t], fits);
             else
-                pairForces(p, pairs, interactions, dt, sink, localStats, changes);
+                pairForces(p, pairs, interactions, dt, sink, localStats, changes, fits);
             wallForces(p, wallContacts, walls, wallCandidates, interactions, time, dt, begin, end, p.force.data(),
                        p.torque.data(), wallRecords, localStats);
             stats[t] = localStats;
@@ -199,6 +215,8 @@ private:
     std::vector<ContactHistoryPool::Changes> changes_;  // per thread, reused
     std::vector<std::unique_ptr<ContactBatch>> batches_;  // per thread, reused (45 kB each)
     std::vector<std::vector<WallContactRecord>> newWall_;  // per thread, reused
+    std::vector<CachedBridgeFit> bridgeFits_;  // per list entry (capillary only)
+    long fitsListVersion_ = -1;                // pairs.version() they belong to
 
     // The pair list's arrays as the pair loops read and write them.
     struct PairListArrays {
@@ -232,23 +250,32 @@ private:
     double bridgeForce(double& volume, double overlap, double r1, double r2, std::size_t& holding,
                        double& releasedLiquid) const {
         if (!(volume > 0.0)) return 0.0;
+        CachedBridgeFit cached;
+        return pairBridgeForce(volume, cached, overlap, r1, r2, holding, releasedLiquid);
+    }
+
+    // The same for a listed pair, whose fit of eqs 2-5 is kept with the list
+    // entry while the bridge volume (the key) stays: the logarithm, the power
+    // and the cube root once per bridge and list build, not at every step.
+    double pairBridgeForce(double& volume, CachedBridgeFit& cached, double overlap, double r1, double r2,
+                           std::size_t& holding, double& releasedLiquid) const {
+        if (!(volume > 0.0)) return 0.0;
+        if (cached.volume != volume) cached = {volume, capillaryBridgeFit(r1, r2, volume, settings_.capillary)};
         const double gap = -overlap;
-        // In contact (gap <= 0) a bridge cannot exceed its debonding distance:
-        // the cube root is only taken for bridges across a gap.
-        if (gap > 0.0 && gap > debondingDistance(volume, settings_.capillary.contactAngle)) {
+        if (gap > cached.fit.debonding) {
             releasedLiquid += volume;  // back to the free liquid
             volume = 0.0;
             return 0.0;
         }
         ++holding;
-        return settings_.capillaryForceScale * capillaryForceWithinReach(r1, r2, gap, volume, settings_.capillary);
+        return settings_.capillaryForceScale * capillaryForceOfFit(cached.fit, gap);
     }
 
     // The scalar pair loop (settings_.vectorizedPairLaw = false): one contact
     // after the other through ContactLaw::evaluate; the reference of pairForcesBatched.
     void pairForces(ParticleStore& p, ParticleParticleNeighborList& pairs,
                     const InteractionTable& interactions, double dt, ForceSink& sink, ContactStatistics& stats,
-                    ContactHistoryPool::Changes& changes) const {
+                    ContactHistoryPool::Changes& changes, CachedBridgeFit* fits) const {
         const int begin = sink.begin;
         const int end = sink.end;
         constexpr bool keepsRolling = Rolling == RollingModel::EPSD || Rolling == RollingModel::EPSD2;
@@ -277,7 +304,7 @@ private:
 
                 double cohesiveForce = 0.0;
                 if constexpr (Cohesion == CohesionModel::Capillary) {
-                    cohesiveForce = bridgeForce(bridge[k], overlap, ri, rj, stats.bridges, stats.releasedLiquid);
+                    cohesiveForce = pairBridgeForce(bridge[k], fits[k], overlap, ri, rj, stats.bridges, stats.releasedLiquid);
                     if (overlap <= 0.0) {
                         forgetSprings(slot, k, changes);
                         if (cohesiveForce != 0.0) {
@@ -344,7 +371,8 @@ private:
     // results are bitwise those of pairForces (same operations, same sums).
     void pairForcesBatched(ParticleStore& p, ParticleParticleNeighborList& pairs,
                            const InteractionTable& interactions, double dt, ForceSink& sink,
-                           ContactStatistics& stats, ContactHistoryPool::Changes& changes, ContactBatch& b) const {
+                           ContactStatistics& stats, ContactHistoryPool::Changes& changes, ContactBatch& b,
+                           CachedBridgeFit* fits) const {
         const int begin = sink.begin;
         const int end = sink.end;
         constexpr bool keepsRolling = Rolling == RollingModel::EPSD || Rolling == RollingModel::EPSD2;
@@ -382,7 +410,8 @@ private:
                         // compute the same root and normal again).
                         bool touching = true;
                         const double overlap = radiusSum - std::sqrt(dist2);
-                        const double cohesiveForce = bridgeForce(bridge[k], overlap, ri, rj, stats.bridges, stats.releasedLiquid);
+                        const double cohesiveForce =
+                            pairBridgeForce(bridge[k], fits[k], overlap, ri, rj, stats.bridges, stats.releasedLiquid);
                         if (overlap <= 0.0) {
                             forgetSprings(slot, k, changes);
                             if (cohesiveForce == 0.0) continue;

@@ -88,6 +88,7 @@ void ParticleParticleNeighborList::setStateAt(std::size_t k, const PairState& s)
 
 void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
                                              const std::vector<Vec3>& positions, std::size_t listedRows) {
+    ++version_;
     const int n = static_cast<int>(particles.size());
     // Rows listed (first particles of pairs): all but MPI ghosts.
     const int rows = static_cast<int>(std::min(listedRows, particles.size()));
@@ -259,6 +260,7 @@ void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
 }
 
 void ParticleParticleNeighborList::remap(const std::vector<int>& oldToNew) {
+    ++version_;
     touchingOffsets_.clear();  // rows moved: known again at the next build
     const int oldN = static_cast<int>(offsets_.size()) - 1;
     int newN = 0;

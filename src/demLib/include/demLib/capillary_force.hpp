@@ -59,23 +59,47 @@ inline double debondingDistance(double bridgeVolume, double contactAngle) {
     return (1.0 + 0.5 * contactAngle) * std::cbrt(bridgeVolume);
 }
 
+// What eq 1 needs of one bridge besides its gap, fixed while its volume and
+// radii are: a bridge is evaluated at every step between list updates, its
+// volume only changes at them, so the force loop keeps these per bridge and
+// spends one exp per step on a bridge across a gap and none on one in contact.
+struct CapillaryBridgeFit {
+    double debonding = 0.0;     // δmax, eq 5
+    double largerRadius = 0.0;  // R2
+    double A = 0.0, B = 0.0, C = 0.0;
+    double prefactor = 0.0;     // -π γ √(R1 R2)
+    double contactForce = 0.0;  // eq 1 at δ* <= 0: prefactor (exp(B) + C)
+};
+
+inline CapillaryBridgeFit capillaryBridgeFit(double radius1, double radius2, double bridgeVolume,
+                                             const CapillaryParameters& parameters) {
+    if (radius1 > radius2) std::swap(radius1, radius2);  // the fit is written for R1 ≤ R2
+    CapillaryBridgeFit fit;
+    fit.debonding = debondingDistance(bridgeVolume, parameters.contactAngle);
+    fit.largerRadius = radius2;
+    const double reducedVolume = bridgeVolume / (radius2 * radius2 * radius2);
+    const double logVolume = std::log(reducedVolume);
+    fit.A = capillaryFitA(reducedVolume);
+    fit.B = capillaryFitB(logVolume, parameters.contactAngle);
+    fit.C = capillaryFitC(logVolume);
+    fit.prefactor = -capillary_detail::pi * parameters.surfaceTension * std::sqrt(radius1 * radius2);
+    fit.contactForce = fit.prefactor * (std::exp(fit.B) + fit.C);
+    return fit;
+}
+
+// Eq 1 of a fitted bridge at `gap` (within its debonding distance).
+inline double capillaryForceOfFit(const CapillaryBridgeFit& fit, double gap) {
+    const double reducedGap = gap / fit.largerRadius;
+    if (!(reducedGap > 0.0)) return fit.contactForce;
+    return fit.prefactor * (std::exp(fit.A * reducedGap + fit.B) + fit.C);
+}
+
 // capillaryForce for a bridge already known to hold liquid and to lie within its
 // debonding distance (the contact loop tests that first, to release broken
 // bridges): the same value without computing eq 5 a second time.
 inline double capillaryForceWithinReach(double radius1, double radius2, double gap, double bridgeVolume,
                                         const CapillaryParameters& parameters) {
-    if (radius1 > radius2) std::swap(radius1, radius2);  // the fit is written for R1 ≤ R2
-    const double largerRadius = radius2;
-    const double reducedVolume = bridgeVolume / (largerRadius * largerRadius * largerRadius);
-    const double reducedGap = gap / largerRadius;
-    // Particles in contact (δ* ≤ 0) need only B and C: A's power is the
-    // costliest term of the fit, and most bridges of a dense wet bed are in contact.
-    const double logVolume = std::log(reducedVolume);
-    const double B = capillaryFitB(logVolume, parameters.contactAngle);
-    const double C = capillaryFitC(logVolume);
-    const double shape = reducedGap > 0.0 ? std::exp(capillaryFitA(reducedVolume) * reducedGap + B) + C
-                                          : std::exp(B) + C;
-    return -capillary_detail::pi * parameters.surfaceTension * std::sqrt(radius1 * radius2) * shape;
+    return capillaryForceOfFit(capillaryBridgeFit(radius1, radius2, bridgeVolume, parameters), gap);
 }
 
 // Eq 1 between spheres of radii R1, R2 (either order) separated by `gap`

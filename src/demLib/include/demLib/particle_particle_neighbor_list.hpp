@@ -132,6 +132,9 @@ public:
     const std::vector<int>& touchingOffsets() const { return touchingOffsets_; }
     std::size_t pairCount() const { return neighbors_.size(); }
     long buildCount() const { return buildCount_; }
+    // Changes whenever the entries change meaning (build, relist, remap,
+    // restore): data kept per entry elsewhere is stale then.
+    long version() const { return version_; }
 
     // Restart support: the list is a pure function of the positions at the last
     // build (and the bridge listing limit, set before), so restoring those and
@@ -174,6 +177,7 @@ private:
     std::vector<double> bridgeVolume_;
     std::vector<Vec3> positionAtBuild_;
     long buildCount_ = 0;
+    long version_ = 0;
 };
 
 }  // namespace dem
