@@ -45,10 +45,12 @@ void ParticleWallContacts::remap(const std::vector<int>& oldToNew) {
 }
 
 WallProximityQuery::WallProximityQuery(const std::vector<Wall>& walls, double time)
-    : walls_(walls), time_(time), active_(walls.size()), boxes_(walls.size()) {
+    : walls_(walls), time_(time), active_(walls.size()), boxes_(walls.size()), poses_(walls.size()) {
     for (std::size_t w = 0; w < walls.size(); ++w) {
         active_[w] = walls[w].isActive(time);
-        if (active_[w]) boxes_[w] = walls[w].boundingBox(time);
+        if (!active_[w]) continue;
+        boxes_[w] = walls[w].boundingBox(time);
+        if (!walls[w].motion.isStatic()) poses_[w] = walls[w].motion.at(time);
     }
 }
 

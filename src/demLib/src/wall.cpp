@@ -8,12 +8,16 @@ void Wall::findContacts(const Vec3& centre, double radius, double time, std::vec
     if (!isActive(time)) {
         return;
     }
-    const std::size_t firstNew = out.size();
+    findContacts(centre, radius, time, motion.isStatic() ? RigidTransform{} : motion.at(time), out);
+}
+
+void Wall::findContacts(const Vec3& centre, double radius, double time, const RigidTransform& pose,
+                        std::vector<WallContact>& out) const {
     if (motion.isStatic()) {
         std::visit([&](const auto& surface) { surface.findContacts(centre, radius, out); }, shape);
         return;  // wall velocity stays zero
     }
-    const RigidTransform pose = motion.at(time);
+    const std::size_t firstNew = out.size();
     const Vec3 referenceCentre = pose.applyInverse(centre);
     std::visit([&](const auto& surface) { surface.findContacts(referenceCentre, radius, out); }, shape);
     for (std::size_t i = firstNew; i < out.size(); ++i) {

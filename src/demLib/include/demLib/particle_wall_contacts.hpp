@@ -103,7 +103,7 @@ private:
         const double searchRadius = radius + reach;
         if (!active_[w] || !boxes_[w].overlapsSphere(centre, searchRadius)) return;
         found_.clear();
-        walls_[w].findContacts(centre, searchRadius, time_, found_);
+        walls_[w].findContacts(centre, searchRadius, time_, poses_[w], found_);
         for (WallContact& c : found_) {
             if (reach != 0.0) c.overlap -= reach;
             visit(w, c);
@@ -114,6 +114,7 @@ private:
     double time_;
     std::vector<char> active_;
     std::vector<BoundingBox> boxes_;
+    std::vector<RigidTransform> poses_;  // of the active walls at time_
     std::vector<WallContact> found_;
 };
 

@@ -29,6 +29,10 @@ struct Wall {
     // Appends the contacts of a sphere at world position `centre` at `time`
     // (nothing once the wall is removed).  World-frame normal, point and wall velocity.
     void findContacts(const Vec3& centre, double radius, double time, std::vector<WallContact>& out) const;
+    // The same for an active wall whose pose at `time` (motion.at(time)) the
+    // caller already has: a moving wall is met by every particle in a step.
+    void findContacts(const Vec3& centre, double radius, double time, const RigidTransform& pose,
+                      std::vector<WallContact>& out) const;
 
     // World-frame axis-aligned box enclosing the wall at `time` (unbounded for
     // planes, empty once removed).  A sphere whose box misses it has no
