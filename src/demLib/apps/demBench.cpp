@@ -16,11 +16,17 @@
 //       coordination number, kinetic energy) every S steps and 'result' lines
 //       (key value) that bench/run parses.
 //
+//   demBench copies -case DIR -bed FILE -steps K [-copies C]
+//       C independent simulations of the bed at once, each on its own thread
+//       with one OpenMP thread: what C cores give for work that shares
+//       nothing, the ceiling of C threads on one simulation.
+//
 // Settling from a loose packing under gravity takes long in physical time
 // (the top of the column falls by half the bed height); -gravityFactor G > 1
 // shortens it (sqrt(G) times), after which the bed relaxes under 1 g for
 // -relaxTime, so the stored bed carries the 1 g overlaps.
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -31,6 +37,7 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #ifdef _OPENMP
@@ -294,6 +301,59 @@ int settle(const Options& o) {
     return 0;
 }
 
+// K independent copies of the bed's simulation at once, one thread each, in
+// this process: what K cores give for work that shares nothing (the ceiling
+// for K threads on one simulation; bench/run (d) prints it beside them).
+int independentCopies(const Options& o) {
+    const std::string caseDir = o.get("case");
+    const int copies = static_cast<int>(o.number("copies", 2));
+    const long steps = static_cast<long>(o.number("steps", 1000));
+    if (copies < 1) throw dem::InputError("demBench copies: -copies expects an integer >= 1");
+    const std::vector<dem::InsertedParticle> bed = readBed(o.get("bed"));
+    std::vector<double> rate(copies, 0.0);
+    std::vector<unsigned long long> hash(copies, 0);
+    std::vector<std::string> errors(copies);
+    std::atomic<int> ready{0};
+    auto work = [&](int c) {
+        try {
+#ifdef _OPENMP
+            omp_set_num_threads(1);  // a new thread starts from OMP_NUM_THREADS, not main's setting
+#endif
+            // Each copy is built by its own thread (its memory first touched there).
+            dem::CaseSetup setup = dem::readCaseSetup(caseDir);
+            const int material = setup.insertions.empty() ? 0 : setup.insertions.front().materialIndex;
+            std::unique_ptr<dem::Simulation> sim = dem::makeSimulation(setup);
+            sim->insert(bed, material, dem::Vec3::Zero(), "bed");
+            if (setup.waterContent > 0.0) sim->setWaterContent(setup.waterContent);
+            sim->step(1);
+            ++ready;
+            while (ready.load() < copies) std::this_thread::yield();  // start together
+            const auto start = Clock::now();
+            sim->step(steps);
+            rate[c] = static_cast<double>(sim->particles().size()) * steps / secondsSince(start);
+            hash[c] = stateHash(sim->particles());
+        } catch (const std::exception& e) {
+            errors[c] = e.what();
+            ++ready;
+        }
+    };
+    std::vector<std::thread> threads;
+    for (int c = 0; c < copies; ++c) threads.emplace_back(work, c);
+    for (auto& t : threads) t.join();
+    for (const std::string& e : errors)
+        if (!e.empty()) throw dem::RuntimeError("demBench copies: " + e);
+    double total = 0.0;
+    std::cout << std::setprecision(6);
+    for (int c = 0; c < copies; ++c) {
+        std::cout << "result copy" << c << "_particle_steps_per_s " << rate[c] << "\n"
+                  << "result copy" << c << "_state_hash " << std::hex << hash[c] << std::dec << "\n";
+        total += rate[c];
+    }
+    std::cout << "result copies " << copies << "\n"
+              << "result aggregate_particle_steps_per_s " << total << std::endl;
+    return 0;
+}
+
 int timeSteps(const Options& o) {
     const std::string caseDir = o.get("case");
     dem::CaseSetup setup = dem::readCaseSetup(caseDir);
@@ -363,6 +423,7 @@ void usage(std::ostream& out) {
            "                       [-packing PHI]\n"
            "                       [-gravityFactor G] [-settleTime T] [-relaxTime T] [-speedTolerance V]\n"
            "       demBench time -case DIR -bed FILE -steps K [-threads N] [-sample S]\n"
+           "       demBench copies -case DIR -bed FILE -steps K [-copies C]   (C independent 1-thread runs at once)\n"
            "Benchmark driver of bench/run; see docs/performance.md.\n";
 }
 
@@ -390,7 +451,8 @@ int main(int argc, char** argv) {
     try {
         if (command == "settle") return settle(o);
         if (command == "time") return timeSteps(o);
-        std::cerr << "demBench: unknown command '" << command << "'; expected 'settle' or 'time'\n";
+        if (command == "copies") return independentCopies(o);
+        std::cerr << "demBench: unknown command '" << command << "'; expected 'settle', 'time' or 'copies'\n";
         usage(std::cerr);
         return 1;
     } catch (const dem::InputError& e) {
