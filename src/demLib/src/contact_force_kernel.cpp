@@ -406,8 +406,14 @@ private:
                         if ((slot[k] >= 0) & !touching) forgetSprings(slot, k, changes);  // rare: a contact that opened
                         count += touching;
                     } else {
-                        // The bridge needs the gap of every listed pair (the lanes
-                        // compute the same root and normal again).
+                        // A pair without a bridge that is clearly apart needs no
+                        // root (the margin keeps the root's verdict: sqrt(dist2) > R).
+                        if (!(bridge[k] > 0.0) && dist2 > radiusSum * radiusSum * (1.0 + 1e-12)) {
+                            forgetSprings(slot, k, changes);
+                            continue;
+                        }
+                        // The bridge needs the gap of every other listed pair (the
+                        // lanes compute the same root and normal again).
                         bool touching = true;
                         const double overlap = radiusSum - std::sqrt(dist2);
                         const double cohesiveForce =

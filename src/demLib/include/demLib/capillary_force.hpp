@@ -89,8 +89,10 @@ inline CapillaryBridgeFit capillaryBridgeFit(double radius1, double radius2, dou
 
 // Eq 1 of a fitted bridge at `gap` (within its debonding distance).
 inline double capillaryForceOfFit(const CapillaryBridgeFit& fit, double gap) {
+    // In contact no division: a gap > 0 whose δ* underflows to 0 gives
+    // exp(A·0 + B) + C, the contact value, on either branch.
+    if (!(gap > 0.0)) return fit.contactForce;
     const double reducedGap = gap / fit.largerRadius;
-    if (!(reducedGap > 0.0)) return fit.contactForce;
     return fit.prefactor * (std::exp(fit.A * reducedGap + fit.B) + fit.C);
 }
 
