@@ -59,9 +59,12 @@ struct ForceSink {
     }
 };
 
-// A bridge's fit and the volume it was made for (-1: none yet).
+// A bridge's fit and what it was made for: the volume and the list version
+// (ParticleParticleNeighborList::version(); -1: none yet).  Comparing both
+// spares clearing the whole cache at every list build.
 struct CachedBridgeFit {
     double volume = -1.0;
+    long listVersion = -1;
     CapillaryBridgeFit fit;
 };
 
@@ -132,15 +135,13 @@ public:
             return lo;
         };
 
-        // Bridge fits per list entry, forgotten when the list changes.
+        // Bridge fits per list entry (stale ones carry an older list version).
         CachedBridgeFit* fits = nullptr;
         if constexpr (Cohesion == CohesionModel::Capillary) {
-            if (fitsListVersion_ != pairs.version() || bridgeFits_.size() != pairs.pairCount()) {
-                bridgeFits_.assign(pairs.pairCount(), CachedBridgeFit{});
-                fitsListVersion_ = pairs.version();
-            }
+            if (bridgeFits_.size() < pairs.pairCount()) bridgeFits_.resize(pairs.pairCount());
             fits = bridgeFits_.data();
         }
+        const long listVersion = pairs.version();
 
 #pragma omp parallel num_threads(threads)
         {
@@ -158,9 +159,9 @@ public:
             ContactHistoryPool::Changes changes = std::move(changes_[t]);
             std::vector<WallContactRecord> wallRecords = std::move(newWall[t]);
             if (settings_.vectorizedPairLaw)
-                pairForcesBatched(p, pairs, interactions, dt, sink, localStats, changes, *batches_[t], fits);
+                pairForcesBatched(p, pairs, interactions, dt, sink, localStats, changes, *batches_[t], fits, listVersion);
             else
-                pairForces(p, pairs, interactions, dt, sink, localStats, changes, fits);
+                pairForces(p, pairs, interactions, dt, sink, localStats, changes, fits, listVersion);
             wallForces(p, wallContacts, walls, wallCandidates, interactions, time, dt, begin, end, p.force.data(),
                        p.torque.data(), wallRecords, localStats);
             stats[t] = localStats;
@@ -216,7 +217,6 @@ private:
     std::vector<std::unique_ptr<ContactBatch>> batches_;  // per thread, reused (45 kB each)
     std::vector<std::vector<WallContactRecord>> newWall_;  // per thread, reused
     std::vector<CachedBridgeFit> bridgeFits_;  // per list entry (capillary only)
-    long fitsListVersion_ = -1;                // pairs.version() they belong to
 
     // The pair list's arrays as the pair loops read and write them.
     struct PairListArrays {
@@ -251,16 +251,17 @@ private:
                        double& releasedLiquid) const {
         if (!(volume > 0.0)) return 0.0;
         CachedBridgeFit cached;
-        return pairBridgeForce(volume, cached, overlap, r1, r2, holding, releasedLiquid);
+        return pairBridgeForce(volume, cached, -1, overlap, r1, r2, holding, releasedLiquid);
     }
 
     // The same for a listed pair, whose fit of eqs 2-5 is kept with the list
     // entry while the bridge volume (the key) stays: the logarithm, the power
     // and the cube root once per bridge and list build, not at every step.
-    double pairBridgeForce(double& volume, CachedBridgeFit& cached, double overlap, double r1, double r2,
-                           std::size_t& holding, double& releasedLiquid) const {
+    double pairBridgeForce(double& volume, CachedBridgeFit& cached, long listVersion, double overlap, double r1,
+                           double r2, std::size_t& holding, double& releasedLiquid) const {
         if (!(volume > 0.0)) return 0.0;
-        if (cached.volume != volume) cached = {volume, capillaryBridgeFit(r1, r2, volume, settings_.capillary)};
+        if (cached.volume != volume || cached.listVersion != listVersion)
+            cached = {volume, listVersion, capillaryBridgeFit(r1, r2, volume, settings_.capillary)};
         const double gap = -overlap;
         if (gap > cached.fit.debonding) {
             releasedLiquid += volume;  // back to the free liquid
@@ -275,7 +276,7 @@ private:
     // after the other through ContactLaw::evaluate; the reference of pairForcesBatched.
     void pairForces(ParticleStore& p, ParticleParticleNeighborList& pairs,
                     const InteractionTable& interactions, double dt, ForceSink& sink, ContactStatistics& stats,
-                    ContactHistoryPool::Changes& changes, CachedBridgeFit* fits) const {
+                    ContactHistoryPool::Changes& changes, CachedBridgeFit* fits, long listVersion) const {
         const int begin = sink.begin;
         const int end = sink.end;
         constexpr bool keepsRolling = Rolling == RollingModel::EPSD || Rolling == RollingModel::EPSD2;
@@ -304,7 +305,8 @@ private:
 
                 double cohesiveForce = 0.0;
                 if constexpr (Cohesion == CohesionModel::Capillary) {
-                    cohesiveForce = pairBridgeForce(bridge[k], fits[k], overlap, ri, rj, stats.bridges, stats.releasedLiquid);
+                    cohesiveForce = pairBridgeForce(bridge[k], fits[k], listVersion, overlap, ri, rj, stats.bridges,
+                                                    stats.releasedLiquid);
                     if (overlap <= 0.0) {
                         forgetSprings(slot, k, changes);
                         if (cohesiveForce != 0.0) {
@@ -372,7 +374,7 @@ private:
     void pairForcesBatched(ParticleStore& p, ParticleParticleNeighborList& pairs,
                            const InteractionTable& interactions, double dt, ForceSink& sink,
                            ContactStatistics& stats, ContactHistoryPool::Changes& changes, ContactBatch& b,
-                           CachedBridgeFit* fits) const {
+                           CachedBridgeFit* fits, long listVersion) const {
         const int begin = sink.begin;
         const int end = sink.end;
         constexpr bool keepsRolling = Rolling == RollingModel::EPSD || Rolling == RollingModel::EPSD2;
@@ -417,7 +419,8 @@ private:
                         bool touching = true;
                         const double overlap = radiusSum - std::sqrt(dist2);
                         const double cohesiveForce =
-                            pairBridgeForce(bridge[k], fits[k], overlap, ri, rj, stats.bridges, stats.releasedLiquid);
+                            pairBridgeForce(bridge[k], fits[k], listVersion, overlap, ri, rj, stats.bridges,
+                                            stats.releasedLiquid);
                         if (overlap <= 0.0) {
                             forgetSprings(slot, k, changes);
                             if (cohesiveForce == 0.0) continue;
