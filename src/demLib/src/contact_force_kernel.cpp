@@ -255,8 +255,9 @@ private:
     }
 
     // The same for a listed pair, whose fit of eqs 2-5 is kept with the list
-    // entry while the bridge volume (the key) stays: the logarithm, the power
-    // and the cube root once per bridge and list build, not at every step.
+    // entry while its volume and the list version (the key) stay: the
+    // logarithm, the power and the cube root once per bridge and list build,
+    // not at every step.
     double pairBridgeForce(double& volume, CachedBridgeFit& cached, long listVersion, double overlap, double r1,
                            double r2, std::size_t& holding, double& releasedLiquid) const {
         if (!(volume > 0.0)) return 0.0;

@@ -83,12 +83,16 @@ double bridgeVolumeWeight(double radiusOfA, double radiusOfB, double distanceOfC
     return 0.0;  // unreachable: every enumerator is handled above
 }
 
+double bridgeStabilityThreshold(double gap, double weight, double contactAngle) {
+    const double scaledGap = std::max(gap, 0.0) / (1.0 + 0.5 * contactAngle);
+    return scaledGap * scaledGap * scaledGap / weight;
+}
+
 double bridgeStabilityThreshold(double radiusOfA, double radiusOfB, double distanceOfCentres,
                                 const LiquidBridgeSettings& settings) {
-    const double gap = distanceOfCentres - radiusOfA - radiusOfB;
-    const double scaledGap = std::max(gap, 0.0) / (1.0 + 0.5 * settings.contactAngle);
-    return scaledGap * scaledGap * scaledGap /
-           bridgeVolumeWeight(radiusOfA, radiusOfB, distanceOfCentres, settings.weight);
+    return bridgeStabilityThreshold(distanceOfCentres - radiusOfA - radiusOfB,
+                                    bridgeVolumeWeight(radiusOfA, radiusOfB, distanceOfCentres, settings.weight),
+                                    settings.contactAngle);
 }
 
 LiquidBridgeNetwork::LiquidBridgeNetwork(double totalLiquidVolume, const LiquidBridgeSettings& settings)
@@ -130,7 +134,7 @@ const BridgeDistribution& LiquidBridgeNetwork::update(const BridgeCandidates& ca
         const double gap = distance - ra - rb;
         if (persistent && gap > 0.0 && !candidates.wasBonded[k]) continue;  // no contact, no bridge yet
         weight_[k] = bridgeVolumeWeight(ra, rb, distance, settings_.weight);
-        stabilityThreshold_[k] = bridgeStabilityThreshold(ra, rb, distance, settings_);
+        stabilityThreshold_[k] = bridgeStabilityThreshold(gap, weight_[k], settings_.contactAngle);
         if (stabilityThreshold_[k] > 0.0)
             separatedPairs_.emplace_back(stabilityThreshold_[k], k);
         else

@@ -96,22 +96,15 @@ inline double capillaryForceOfFit(const CapillaryBridgeFit& fit, double gap) {
     return fit.prefactor * (std::exp(fit.A * reducedGap + fit.B) + fit.C);
 }
 
-// capillaryForce for a bridge already known to hold liquid and to lie within its
-// debonding distance (the contact loop tests that first, to release broken
-// bridges): the same value without computing eq 5 a second time.
-inline double capillaryForceWithinReach(double radius1, double radius2, double gap, double bridgeVolume,
-                                        const CapillaryParameters& parameters) {
-    return capillaryForceOfFit(capillaryBridgeFit(radius1, radius2, bridgeVolume, parameters), gap);
-}
-
 // Eq 1 between spheres of radii R1, R2 (either order) separated by `gap`
 // (surface-to-surface; negative when they overlap) and joined by a bridge of
 // volume `bridgeVolume`.  Zero when there is no liquid or gap > δmax (eq 5).
 inline double capillaryForce(double radius1, double radius2, double gap, double bridgeVolume,
                              const CapillaryParameters& parameters) {
     if (!(bridgeVolume > 0.0)) return 0.0;
-    if (gap > debondingDistance(bridgeVolume, parameters.contactAngle)) return 0.0;
-    return capillaryForceWithinReach(radius1, radius2, gap, bridgeVolume, parameters);
+    const CapillaryBridgeFit fit = capillaryBridgeFit(radius1, radius2, bridgeVolume, parameters);
+    if (gap > fit.debonding) return 0.0;
+    return capillaryForceOfFit(fit, gap);
 }
 
 // The radius of the sphere pair that stands in for a sphere-plane bridge.

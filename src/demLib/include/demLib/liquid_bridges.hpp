@@ -84,6 +84,8 @@ double bridgeVolumeWeight(double radiusOfA, double radiusOfB, double distanceOfC
 // between the pair at liquid per weight λ iff λ ≥ λ*_k.
 double bridgeStabilityThreshold(double radiusOfA, double radiusOfB, double distanceOfCentres,
                                 const LiquidBridgeSettings& settings);
+// The same from the pair's gap and its weight w_k, when the caller has them.
+double bridgeStabilityThreshold(double gap, double weight, double contactAngle);
 
 // Holds the total liquid of the sample and re-distributes it each time the
 // engine updates its contact list.  Scratch storage is kept between updates,

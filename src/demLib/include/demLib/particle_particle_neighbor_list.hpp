@@ -80,7 +80,7 @@ public:
     // within the extra range are listed only where a liquid bridge could hold
     // at liquid per unit weight `liquidPerWeightLimit` (λ*_k <= limit, see
     // bridgeStabilityThreshold): in a polydisperse wet bed the extra range of
-    // the largest bridge otherwise lists five times more pairs than touch.
+    // the largest bridge otherwise lists about three times more pairs.
     // Infinity (the default) lists every pair within the extra range.
     void setBridgeListing(const LiquidBridgeSettings& settings, double liquidPerWeightLimit);
     double bridgeListingLimit() const { return bridgeListingLimit_; }
