@@ -4,6 +4,7 @@
 // results bitwise unchanged), with 1 and 2 threads.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 #include <vector>
 
@@ -62,7 +63,7 @@ Outcome run(bool fused, double skin, double dt, int threads) {
         extras.limitSquared = list.rebuildDisplacementSquared();
         extras.resetForces = true;
         extras.gravity = g;
-        out.movedFar = dem::kickKickAndDrift(p, dt, p.size(), extras);
+        out.movedFar = dem::kickKickAndDrift(p, dt, p.size(), extras).movedFar;
     } else {
         dem::kick(p, dt);
         dem::kickAndDrift(p, dt);
@@ -101,5 +102,41 @@ TEST(FusedDrift, KicksDriftRebuildTestAndForceResetAreThoseOfSeparateLoops) {
         const Vec3 expected = p.mass[i] * Vec3(0.0, 0.0, -9.81) + p.externalForce[i];
         EXPECT_EQ(p.force[i], expected) << i;
         EXPECT_TRUE(p.torque[i].isZero(0.0)) << i;
+    }
+}
+
+// The lost-particle test in the drift: reports a particle that ends outside
+// the box or not finite (as Simulation::removeLostParticles tests), and
+// nothing when all are inside or when the test is not asked for.
+TEST(FusedDrift, ReportsAParticleThatLeavesTheDomainBoxOrIsNotFinite) {
+    // The rebuild test's list, built at the finite start positions.
+    dem::ParticleParticleNeighborList list;
+    list.setRanges(1e-3, 0.0);
+    list.build(randomParticles(9));
+    auto drift = [&](dem::ParticleStore p, const Vec3& lo, const Vec3& hi, bool test, int threads) {
+        ThreadCount scope(threads);
+        dem::DriftExtras extras;
+        extras.displacementFrom = list.positionsAtBuild().data();
+        extras.limitSquared = list.rebuildDisplacementSquared();
+        extras.testDomain = test;
+        extras.domainMin = lo;
+        extras.domainMax = hi;
+        return dem::kickKickAndDrift(p, 1e-4, p.size(), extras).leftDomain;
+    };
+    // Positions within [-0.1, 0.1] + 0.5 m/s x 1e-4 s: inside a box of +-0.2.
+    const Vec3 lo(-0.2, -0.2, -0.2), hi(0.2, 0.2, 0.2);
+    for (int threads : {1, 2}) {
+        const dem::ParticleStore p = randomParticles(9);
+        EXPECT_FALSE(drift(p, lo, hi, true, threads));
+        // Tighter in one direction only: some end above z = 0.05.
+        EXPECT_TRUE(drift(p, lo, Vec3(0.2, 0.2, 0.05), true, threads));
+        EXPECT_FALSE(drift(p, lo, Vec3(0.2, 0.2, 0.05), false, threads));
+        // One particle (the last, on the second thread's share) out below, or not finite.
+        for (double bad : {-0.3, std::nan("")}) {
+            dem::ParticleStore q = p;
+            q.position.back().z() = bad;
+            q.velocity.back().setZero();
+            EXPECT_TRUE(drift(q, lo, hi, true, threads)) << bad << ", " << threads << " thread(s)";
+        }
     }
 }

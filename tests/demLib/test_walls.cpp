@@ -241,6 +241,65 @@ TEST(CylinderWall, LateralContactMatchesClosedFormInsideAndOutside) {
     }
 }
 
+// findContacts rejects far spheres from squared distances before its root;
+// near every threshold (the surface, the particle radius off it, the rims)
+// it must still find exactly the contacts of the plain distance test.
+TEST(CylinderWall, EarlyRejectionKeepsEveryContactNearTheThresholds) {
+    std::mt19937_64 rng(23);
+    std::uniform_real_distribution<double> uniform(0.0, 1.0);
+    const double R = 0.05, zMin = -0.02, zMax = 0.1, radius = 0.0025;
+    long found[2] = {0, 0}, rimFound = 0, tested = 0;
+    for (auto side : {dem::CylinderWall::Side::Inside, dem::CylinderWall::Side::Outside}) {
+        const bool inside = side == dem::CylinderWall::Side::Inside;
+        const dem::CylinderWall cylinder(Vec3(0.01, -0.02, 0.03), Vec3(0, 0, 1), R, zMin, zMax, side);
+        for (int trial = 0; trial < 200000; ++trial) {
+            // Radial and axial offsets at, or within a relative 1e-9 of, the
+            // thresholds R, R -+ radius, zMin/zMax (-+ radius), or anywhere.
+            auto nearOneOf = [&](std::initializer_list<double> values, double lo, double hi) {
+                const int pick = static_cast<int>(uniform(rng) * (values.size() + 1));
+                if (pick == static_cast<int>(values.size())) return lo + (hi - lo) * uniform(rng);
+                const double v = *(values.begin() + pick);
+                return v * (1.0 + 1e-9 * (2.0 * uniform(rng) - 1.0) * (uniform(rng) < 0.5 ? 1.0 : 1e-4));
+            };
+            const double rho = nearOneOf({R, R - radius, R + radius}, 0.0, R + 2 * radius);
+            const double z = nearOneOf({zMin, zMax, zMin - radius, zMax + radius}, zMin - 2 * radius,
+                                       zMax + 2 * radius);
+            const double angle = 2 * pi * uniform(rng);
+            const Vec3 centre = Vec3(0.01, -0.02, 0.03) + Vec3(rho * std::cos(angle), rho * std::sin(angle), z);
+            // The plain test, from the computed cylinder coordinates.
+            const Vec3 d = centre - Vec3(0.01, -0.02, 0.03);
+            const double zc = d.z(), rc = std::sqrt(d.x() * d.x() + d.y() * d.y());
+            bool expected;
+            if (zc >= zMin && zc <= zMax) {
+                const double gap = inside ? R - rc : rc - R;
+                expected = gap >= 0.0 && gap < radius;
+            } else {
+                const double zRim = zc < zMin ? zMin : zMax;
+                expected = std::hypot(zc - zRim, rc - R) < radius;
+            }
+            std::vector<WallContact> contacts;
+            cylinder.findContacts(centre, radius, contacts);
+            ++tested;
+            // Exactly at a threshold the two roundings may differ; 1e-9 off it they may not.
+            const double margin = 1e-13;
+            const bool borderline = std::abs(std::abs(rc - R) - radius) < margin || std::abs(rc - R) < margin ||
+                                    std::abs(std::hypot(zc - (zc < zMin ? zMin : zMax), rc - R) - radius) < margin;
+            if (borderline) continue;
+            ASSERT_EQ(contacts.size(), expected ? 1u : 0u)
+                << (inside ? "inside" : "outside") << ": rho " << rc << ", z " << zc;
+            if (expected) {
+                ++found[inside];
+                rimFound += contacts[0].feature != dem::CylinderWall::lateralFeature;
+            }
+        }
+    }
+    // Not vacuous: many contacts on both sides and at the rims.
+    EXPECT_GT(found[0], 10000);
+    EXPECT_GT(found[1], 10000);
+    EXPECT_GT(rimFound, 1000);
+    EXPECT_EQ(tested, 400000);
+}
+
 TEST(CylinderWall, RimContactBeyondAxialRange) {
     // Die wall: axis z, R = 0.05, z in [0, 0.1].
     const dem::CylinderWall die(Vec3(0, 0, 0), Vec3(0, 0, 1), 0.05, 0.0, 0.1, dem::CylinderWall::Side::Inside);

@@ -4,6 +4,7 @@
 #include "mathematicalConstants.H"
 #include "sigFpe.H"
 #include "vectorIOField.H"
+#include "clockValue.H"
 
 #include "demLib/case_runner.hpp"
 #include "demLib/case_setup.hpp"
@@ -367,6 +368,7 @@ void Foam::diefill::demCoupling::evolve()
 
 void Foam::diefill::demCoupling::updateVoidFraction()
 {
+    const clockValue started(true);
     const auto& particles = runner_->simulation().particles();
     const label n = particles.size();
 
@@ -374,6 +376,10 @@ void Foam::diefill::demCoupling::updateVoidFraction()
     weights_.setSize(n);
 
     scalarField found(n, Zero);
+    // demLib keeps particles sorted by position: the previous particle's cell
+    // is a good first guess for the next one (the octree search it spares was
+    // a tenth of the serial time of the full die-filling run)
+    label hint = -1;
     for (label i = 0; i < n; ++i)
     {
         const auto& x = particles.position[i];
@@ -383,6 +389,7 @@ void Foam::diefill::demCoupling::updateVoidFraction()
         (
             point(x.x(), x.y(), x.z()),
             particles.radius[i],
+            hint,
             cells_[i],
             weights_[i]
         );
@@ -460,7 +467,8 @@ void Foam::diefill::demCoupling::updateVoidFraction()
         << " outside the mesh), solid volume: particles " << particleVolume
         << " m3, cells " << cellVolume << " m3; void fraction min "
         << gMin(alpha) << " mean " << gSum(alpha*mesh_.V())/gSum(mesh_.V())
-        << ", " << nClamped << " cell(s) clamped to alphaMin" << endl;
+        << ", " << nClamped << " cell(s) clamped to alphaMin ("
+        << double(started.elapsed()) << " s)" << endl;
 }
 
 

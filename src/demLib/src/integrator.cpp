@@ -30,16 +30,21 @@ inline Vec3 bodyForce(const ParticleStore& p, std::size_t i, const Vec3& g, bool
 // next), then the drift if asked, then the extras.  Each half kick is its own
 // addition, so kicks = 2 rounds exactly like two separate calls.
 template <int kicks, bool drift, bool watch, bool reset>
-bool advance(ParticleStore& p, double dt, std::size_t count, const DriftExtras& extras) {
+DriftReport advance(ParticleStore& p, double dt, std::size_t count, const DriftExtras& extras) {
     const double half = 0.5 * dt;
     const std::size_t n = std::min(count, p.size());
     const Vec3* from = extras.displacementFrom;
     const double limit2 = extras.limitSquared;
     const Vec3 g = extras.gravity;
+    const bool testDomain = extras.testDomain;
+    const auto lo = extras.domainMin.array();
+    const auto hi = extras.domainMax.array();
     const ParticleStore& cp = p;  // reads of externalForce must not allocate it
     const bool external = cp.externalForce.allocated();
     bool moved = false;
-#pragma omp parallel for schedule(static) reduction(|| : moved) num_threads(threadsFor(n, lightLoopParticlesPerThread))
+    bool left = false;
+#pragma omp parallel for schedule(static) reduction(|| : moved, left) \
+    num_threads(threadsFor(n, lightLoopParticlesPerThread))
     for (std::size_t i = 0; i < n; ++i) {
         const InverseMass inv(p.mass[i], p.radius[i]);
         const Vec3 dv = (half * inv.mass) * p.force[i];
@@ -49,17 +54,22 @@ bool advance(ParticleStore& p, double dt, std::size_t count, const DriftExtras& 
             p.omega[i] += dw;
         }
         if constexpr (drift) p.position[i] += dt * p.velocity[i];
-        if constexpr (watch) moved = moved || (p.position[i] - from[i]).squaredNorm() > limit2;
+        if constexpr (watch) {
+            moved = moved || (p.position[i] - from[i]).squaredNorm() > limit2;
+            // AxisAlignedBox::contains and allFinite, as Simulation::removeLostParticles tests.
+            const auto x = p.position[i].array();
+            if (testDomain) left = left || !((x >= lo).all() && (x <= hi).all()) || !p.position[i].allFinite();
+        }
         if constexpr (reset) {
             p.force[i] = bodyForce(cp, i, g, external);
             p.torque[i].setZero();
         }
     }
-    return moved;
+    return {moved, left};
 }
 
 template <int kicks>
-bool advanceWith(ParticleStore& p, double dt, std::size_t count, const DriftExtras& e) {
+DriftReport advanceWith(ParticleStore& p, double dt, std::size_t count, const DriftExtras& e) {
     const bool watch = e.displacementFrom != nullptr;
     if (watch && e.resetForces) return advance<kicks, true, true, true>(p, dt, count, e);
     if (watch) return advance<kicks, true, true, false>(p, dt, count, e);
@@ -76,11 +86,11 @@ void kickKickAndDrift(ParticleStore& p, double dt, std::size_t count) {
     advance<2, true, false, false>(p, dt, count, {});
 }
 
-bool kickAndDrift(ParticleStore& p, double dt, std::size_t count, const DriftExtras& e) {
+DriftReport kickAndDrift(ParticleStore& p, double dt, std::size_t count, const DriftExtras& e) {
     return advanceWith<1>(p, dt, count, e);
 }
 
-bool kickKickAndDrift(ParticleStore& p, double dt, std::size_t count, const DriftExtras& e) {
+DriftReport kickKickAndDrift(ParticleStore& p, double dt, std::size_t count, const DriftExtras& e) {
     return advanceWith<2>(p, dt, count, e);
 }
 

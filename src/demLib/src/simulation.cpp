@@ -204,9 +204,9 @@ double Simulation::coordinationNumber() const {
     return n == 0 ? 0.0 : 2.0 * static_cast<double>(last_.contacts.touchingPairs) / n;
 }
 
-void Simulation::removeLostParticles() {
+void Simulation::removeLostParticles(bool knownNoneLost) {
     last_.lostThisStep = 0;
-    if (!settings_.domain) return;
+    if (!settings_.domain || knownNoneLost) return;
     // With a decomposition each rank removes its own particles; ghosts are
     // dropped first (their owners remove them), so the lists are empty below.
     const auto isLost = [&](std::size_t i) {
@@ -431,16 +431,23 @@ void Simulation::step(long steps) {
         }
         extras.resetForces = fused;
         extras.gravity = settings_.gravity;
+        if (extras.displacementFrom && settings_.domain) {
+            extras.testDomain = true;
+            extras.domainMin = settings_.domain->min;
+            extras.domainMax = settings_.domain->max;
+        }
         return extras;
     };
     bool drifted = false;
-    bool watched = false;   // the drift did the rebuild test ...
-    bool movedFar = false;  // ... with this result
+    bool watched = false;     // the drift did the rebuild test ...
+    DriftReport drifting;     // ... with this result
+    bool domainTested = false;  // ... and the lost-particle test
     auto drift = [&](bool twoKicks) {
         const DriftExtras extras = driftExtras();
-        movedFar = twoKicks ? kickKickAndDrift(particles_, dt, ownedCount(), extras)
+        drifting = twoKicks ? kickKickAndDrift(particles_, dt, ownedCount(), extras)
                             : kickAndDrift(particles_, dt, ownedCount(), extras);
         watched = extras.displacementFrom != nullptr;
+        domainTested = extras.testDomain;
     };
     for (long s = 0; s < steps; ++s) {
         if (!forcesValid_) {
@@ -452,8 +459,8 @@ void Simulation::step(long steps) {
         ++step_;
         // Time from the step count: no drift from summing dt, exact on restart.
         time_ = step_ * dt;
-        removeLostParticles();
-        bool rebuild = last_.lostThisStep > 0 || (watched ? movedFar : pairs_.needsRebuild(particles_));
+        removeLostParticles(domainTested && !drifting.leftDomain);
+        bool rebuild = last_.lostThisStep > 0 || (watched ? drifting.movedFar : pairs_.needsRebuild(particles_));
         if (decomposition_) {
             // All ranks rebuild together (the rebuild exchanges particles).
             rebuild = decomposition_->communicator().anyTrue(rebuild);

@@ -24,6 +24,7 @@ void Foam::diefill::centreVoidFraction::distribute
 (
     const point& centre,
     scalar radius,
+    label& hint,
     DynamicList<label>& cells,
     DynamicList<scalar>& weights
 ) const
@@ -32,9 +33,10 @@ void Foam::diefill::centreVoidFraction::distribute
     {
         return;
     }
-    const label celli = mesh_.findCell(centre);
+    const label celli = findCell(centre, hint);
     if (celli >= 0)
     {
+        hint = celli;
         cells.append(celli);
         weights.append(1);
     }

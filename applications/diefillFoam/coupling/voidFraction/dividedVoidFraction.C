@@ -60,6 +60,7 @@ void Foam::diefill::dividedVoidFraction::distribute
 (
     const point& centre,
     scalar radius,
+    label& hint,
     DynamicList<label>& cells,
     DynamicList<scalar>& weights
 ) const
@@ -70,17 +71,21 @@ void Foam::diefill::dividedVoidFraction::distribute
     }
 
     const scalar share = 1.0/unitPoints_.size();
-    label hint = mesh_.findCell(centre);
+    label near = findCell(centre, hint);
+    if (near >= 0)
+    {
+        hint = near;
+    }
     const label first = cells.size();
 
     for (const vector& u : unitPoints_)
     {
-        const label celli = findCell(centre + radius*u, hint);
+        const label celli = findCell(centre + radius*u, near);
         if (celli < 0)
         {
             continue;
         }
-        hint = celli;
+        near = celli;
 
         // Merge with an entry of the same cell (few cells per particle)
         bool merged = false;

@@ -37,6 +37,12 @@ public:
     std::string latestRestart() const;
 
 private:
+    // Most steps advanceTo hands the engine in one call (keeps the progress
+    // line, which is checked between calls, on time).
+    static constexpr long maxStepsPerCall = 100;
+
+    bool insertionDueAt(double time) const;  // would performDueInsertions insert at this time?
+    bool outputDueAt(double time) const;     // would writeDueOutput(false) write at this time?
     void performDueInsertions();
     void writeDueOutput(bool force);
     void writeSummaryHeader();

@@ -20,6 +20,17 @@ struct DriftExtras {
     // the contacts to it).
     bool resetForces = false;
     Vec3 gravity = Vec3::Zero();
+    // With the rebuild test: also report whether a particle ends outside the
+    // box [domainMin, domainMax] or not finite (the engine's lost-particle
+    // test, which then need not pass over the particles again).
+    bool testDomain = false;
+    Vec3 domainMin = Vec3::Zero(), domainMax = Vec3::Zero();
+};
+
+// What the drift's extras found.
+struct DriftReport {
+    bool movedFar = false;    // a particle moved beyond the rebuild limit
+    bool leftDomain = false;  // a particle is outside the domain box or not finite
 };
 
 // v += dt/2 F/m, ω += dt/2 T/I, then x += dt v, for particles 0 .. count-1
@@ -34,10 +45,10 @@ void kick(ParticleStore& particles, double dt, std::size_t count = static_cast<s
 // the same order per particle, so the same results as the two calls.
 void kickKickAndDrift(ParticleStore& particles, double dt, std::size_t count = static_cast<std::size_t>(-1));
 
-// kickAndDrift / kickKickAndDrift with the extras; returns whether a particle
-// moved farther than the limit (false without a displacement test).
-bool kickAndDrift(ParticleStore& particles, double dt, std::size_t count, const DriftExtras& extras);
-bool kickKickAndDrift(ParticleStore& particles, double dt, std::size_t count, const DriftExtras& extras);
+// kickAndDrift / kickKickAndDrift with the extras (both flags false for a
+// test not asked for).
+DriftReport kickAndDrift(ParticleStore& particles, double dt, std::size_t count, const DriftExtras& extras);
+DriftReport kickKickAndDrift(ParticleStore& particles, double dt, std::size_t count, const DriftExtras& extras);
 
 // F = m g + F_external, T = 0 for particles 0 .. n-1: the start of a force computation.
 void resetForces(ParticleStore& particles, const Vec3& gravity);

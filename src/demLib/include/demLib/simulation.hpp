@@ -156,7 +156,9 @@ public:
     void readRestart(const std::string& path);
 
 private:
-    void removeLostParticles();
+    // Removes particles outside the domain box (or not finite); knownNoneLost:
+    // the drift has just tested every particle and found none (no pass here).
+    void removeLostParticles(bool knownNoneLost = false);
     void updatePairList();
     void rebuildWallCandidates();
     double redistributeLiquid(double wallReach);  // returns λ, the liquid per unit weight
