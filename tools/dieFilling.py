@@ -175,6 +175,52 @@ def die_geometry(d):
     return radius, z1 - z0, z0, opening
 
 
+def report_before_opening(case, out, props, s, frames, poured, fill, opening, end_time, shoe_pass, with_air, wet,
+                          run_time):
+    """The results of a run that has not reached the die opening yet: fill ratio so far,
+    the latest side view, the air's figures; says what is missing and why."""
+    t = s["time"]
+    fill = np.asarray(fill)
+    latest = series.read_frame(frames[-1][1])
+    plots.curve(os.path.join(out, "fillRatio.png"), t, [fill], ["mass in die / mass poured"], "time [s]",
+                "fill ratio [-]", title="die fill ratio (run in progress, t = %.3g s of %g s)" % (t[-1], end_time),
+                vlines=[(opening, "die opening starts")] if opening <= t[-1] * 1.5 else ())
+    plots.side_view(os.path.join(out, "sideView_latest.png"), latest, title=f"latest fields, t = {latest.time:.2f} s")
+    during = (t >= shoe_pass[0]) & (t <= shoe_pass[1]) if shoe_pass else np.zeros(len(t), bool)
+    t50 = first_time_reaching(t, fill, 0.5)
+    t90 = first_time_reaching(t, fill, 0.9)
+    res = {
+        "state": {"value": "in progress", "unit": "-",
+                  "description": "the run has not reached the die opening (t = %g s): no bed profile, angles or "
+                                 "mass lost yet" % opening},
+        "simulatedTime": {"value": float(t[-1]), "unit": "s",
+                          "description": "last time in dem/summary.csv (the case ends at %g s)" % end_time},
+        "massPoured": {"value": poured, "unit": "kg"},
+        "fillRatioLatest": {"value": float(fill[-1]), "unit": "-", "description": "at t = %g s" % t[-1]},
+        "fillTime50": {"value": t50, "unit": "s", "description": "die holds 50 % of the mass poured"},
+        "fillTime90": {"value": t90, "unit": "s", "description": "die holds 90 % of the mass poured"},
+        "meanFillRatioDuringPass": {"value": float(np.mean(fill[during])) if during.any() else None, "unit": "-",
+                                    "description": "fill ratio averaged over the part of the shoe's pass %s s "
+                                                   "simulated so far" % (list(shoe_pass) if shoe_pass else "")},
+        "air": {"value": with_air, "unit": "-", "description": "air solved with the powder (diefillFoam)"},
+        "wet": {"value": wet, "unit": "-", "description": "capillary cohesion (5 % water)"},
+    }
+    if with_air:
+        rho = float(foamdict.read(os.path.join(case, "constant", "transportProperties"))["rho"])
+        density = float(props["materials"]["sand"]["density"])
+        res.update(air_results(case, rho, min(opening, float(t[-1])), out, t, np.asarray(s["mass_die"]) / density))
+    if run_time is not None:
+        res["runTime"] = {"value": run_time, "unit": "s", "description": "wall time of the run"}
+    results.write(case, res)
+    print("dieFilling (%s, %s): run in progress at t = %g s of %g s; the die opens at t = %g s: the bed profile, "
+          "the angles and the mass lost at opening come once the run is past it (run ./Allrun again to continue)"
+          % ("wet" if wet else "dry", "air" if with_air else "vacuum", t[-1], end_time, opening))
+    print("    so far: %.1f g poured, fill ratio %.3f, die 50 %% / 90 %% full at t = %s / %s"
+          % (poured * 1e3, fill[-1], f"{t50:.3f} s" if t50 is not None else "not yet",
+             f"{t90:.3f} s" if t90 is not None else "not yet"))
+    return 0
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("-case", default=".")
@@ -210,6 +256,14 @@ def main():
     t90 = first_time_reaching(t, np.asarray(fill), 0.9)
     with_air = os.path.isdir(os.path.join(case, "constant", "polyMesh"))
     wet = "cohesion" in props
+    end_time = float(props.get("simulation", {}).get("endTime", t[-1]))
+    dt = float(props.get("simulation", {}).get("timeStep", 0.0))
+    in_progress = t[-1] < end_time - max(dt, 1e-9)
+    if t[-1] < opening:
+        # A long run looked at while it goes (or stopped early): what the fill has
+        # shown so far; the profile and the angles need the die wall lowered.
+        return report_before_opening(case, out, props, s, frames, poured, fill, opening, end_time, shoe_pass,
+                                     with_air, wet, a.runTime)
 
     final = series.read_frame(frames[-1][1])
     filled = series.read_frame(min(frames, key=lambda e: abs(e[0] - opening))[1])
@@ -289,6 +343,11 @@ def main():
                                          "description": f"mass in the die / {density:g} kg/m3 at t = {opening} s"}
     if a.runTime is not None:
         res["runTime"] = {"value": a.runTime, "unit": "s", "description": "wall time of demRun"}
+    res["simulatedTime"] = {"value": float(t[-1]), "unit": "s",
+                            "description": "last time in dem/summary.csv (the case ends at %g s)" % end_time}
+    if in_progress:
+        print("dieFilling.py: the run is not finished (t = %g s of %g s): the figures below are those "
+              "of that time, not the final ones" % (t[-1], end_time))
     results.write(case, res)
     print("dieFilling (%s, %s): central angle %.1f deg (fit rms %.1f mm), right border %s deg, fill ratio %.3f, "
           "lost at opening %.1f %%, die 50 %% / 90 %% full at t = %s / %s s"

@@ -64,11 +64,27 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
             if (std::stod(line.substr(0, line.find(','))) <= startTime_ + 1e-12) kept.push_back(line);
         }
     }
-    summary_.open(summaryPath, std::ios::trunc);
-    if (!summary_) throw InputError("cannot write '" + summaryPath.string() + "'");
-    summary_ << std::setprecision(10);
-    if (kept.empty()) writeSummaryHeader();
-    else for (const std::string& l : kept) summary_ << l << "\n";
+    if (kept.empty()) {
+        summary_.open(summaryPath, std::ios::trunc);
+        if (!summary_) throw InputError("cannot write '" + summaryPath.string() + "'");
+        summary_ << std::setprecision(10);
+        writeSummaryHeader();
+    } else {
+        // The kept lines go to a new file that replaces the old one only once it
+        // is complete: a run stopped right after it started (before the stream
+        // would have been flushed) must not leave the history truncated.
+        const fs::path keptPath = summaryPath.string() + ".writing";
+        {
+            std::ofstream rewrite(keptPath, std::ios::trunc);
+            for (const std::string& l : kept) rewrite << l << "\n";
+            rewrite.flush();
+            if (!rewrite) throw InputError("cannot write '" + keptPath.string() + "'");
+        }
+        fs::rename(keptPath, summaryPath);
+        summary_.open(summaryPath, std::ios::app);
+        if (!summary_) throw InputError("cannot write '" + summaryPath.string() + "'");
+        summary_ << std::setprecision(10);
+    }
 
     nextField_ = firstIndexAfter(startTime_, setup_.output.fieldInterval);
     nextLog_ = firstIndexAfter(startTime_, setup_.output.logInterval);
