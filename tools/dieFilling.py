@@ -22,7 +22,10 @@ postProcessing/:
                              mass poured) and, in a run with air (diefillFoam), the mean
                              pressure on the aeration plate while air is blown through the
                              shoe's bed and the volume of air that left the die.
-Heights are measured from the die base (z = -H)."""
+Heights are measured from the die base (z = -H).
+A run that has not reached the die opening yet (a long run looked at while it goes) gets
+fillRatio.png, sideView_latest.png, air.png and results.json with "state": "in progress" and
+the fill so far; the profile and the angles come once the run is past the opening."""
 import argparse
 import os
 import sys
@@ -175,6 +178,26 @@ def die_geometry(d):
     return radius, z1 - z0, z0, opening
 
 
+def common_results(t50, t90, mean_fill_pass, shoe_pass, with_air, wet, pass_note):
+    """The entries of results.json that a finished run and one in progress share."""
+    return {
+        "fillTime50": {"value": t50, "unit": "s", "description": "die holds 50 % of the mass poured"},
+        "fillTime90": {"value": t90, "unit": "s", "description": "die holds 90 % of the mass poured"},
+        "meanFillRatioDuringPass": {"value": mean_fill_pass, "unit": "-",
+                                    "description": "fill ratio averaged over the shoe's pass %s s (%s)"
+                                                   % (list(shoe_pass) if shoe_pass else "", pass_note)},
+        "air": {"value": with_air, "unit": "-", "description": "air solved with the powder (diefillFoam)"},
+        "wet": {"value": wet, "unit": "-", "description": "capillary cohesion (5 % water)"},
+    }
+
+
+def case_air_results(case, props, until, out, s):
+    """air_results with the case's air density and the powder volume in the die."""
+    rho = float(foamdict.read(os.path.join(case, "constant", "transportProperties"))["rho"])
+    density = float(props["materials"]["sand"]["density"])
+    return air_results(case, rho, until, out, s["time"], np.asarray(s["mass_die"]) / density), density
+
+
 def report_before_opening(case, out, props, s, frames, poured, fill, opening, end_time, shoe_pass, with_air, wet,
                           run_time):
     """The results of a run that has not reached the die opening yet: fill ratio so far,
@@ -197,18 +220,11 @@ def report_before_opening(case, out, props, s, frames, poured, fill, opening, en
                           "description": "last time in dem/summary.csv (the case ends at %g s)" % end_time},
         "massPoured": {"value": poured, "unit": "kg"},
         "fillRatioLatest": {"value": float(fill[-1]), "unit": "-", "description": "at t = %g s" % t[-1]},
-        "fillTime50": {"value": t50, "unit": "s", "description": "die holds 50 % of the mass poured"},
-        "fillTime90": {"value": t90, "unit": "s", "description": "die holds 90 % of the mass poured"},
-        "meanFillRatioDuringPass": {"value": float(np.mean(fill[during])) if during.any() else None, "unit": "-",
-                                    "description": "fill ratio averaged over the part of the shoe's pass %s s "
-                                                   "simulated so far" % (list(shoe_pass) if shoe_pass else "")},
-        "air": {"value": with_air, "unit": "-", "description": "air solved with the powder (diefillFoam)"},
-        "wet": {"value": wet, "unit": "-", "description": "capillary cohesion (5 % water)"},
     }
+    res.update(common_results(t50, t90, float(np.mean(fill[during])) if during.any() else None, shoe_pass,
+                              with_air, wet, "the part simulated so far"))
     if with_air:
-        rho = float(foamdict.read(os.path.join(case, "constant", "transportProperties"))["rho"])
-        density = float(props["materials"]["sand"]["density"])
-        res.update(air_results(case, rho, min(opening, float(t[-1])), out, t, np.asarray(s["mass_die"]) / density))
+        res.update(case_air_results(case, props, min(opening, float(t[-1])), out, s)[0])
     if run_time is not None:
         res["runTime"] = {"value": run_time, "unit": "s", "description": "wall time of the run"}
     results.write(case, res)
@@ -324,18 +340,11 @@ def main():
         "fractionLostAtOpening": {"value": lost_at_opening / mass_die_filled if mass_die_filled > 0 else None,
                                   "unit": "-", "description": "of the mass in the die (paper: 0.10 simulated, 0.02 measured)"},
         "openingStart": {"value": opening, "unit": "s"},
-        "fillTime50": {"value": t50, "unit": "s", "description": "die holds 50 % of the mass poured"},
-        "fillTime90": {"value": t90, "unit": "s", "description": "die holds 90 % of the mass poured"},
-        "meanFillRatioDuringPass": {"value": mean_fill_pass, "unit": "-",
-                                    "description": "fill ratio averaged over the shoe's pass %s s (lower: the "
-                                                   "die fills later)" % (list(shoe_pass) if shoe_pass else "")},
-        "air": {"value": with_air, "unit": "-", "description": "air solved with the powder (diefillFoam)"},
-        "wet": {"value": wet, "unit": "-", "description": "capillary cohesion (5 % water)"},
     }
+    res.update(common_results(t50, t90, mean_fill_pass, shoe_pass, with_air, wet, "lower: the die fills later"))
     if with_air:
-        rho = float(foamdict.read(os.path.join(case, "constant", "transportProperties"))["rho"])
-        density = float(props["materials"]["sand"]["density"])
-        res.update(air_results(case, rho, opening, out, t, np.asarray(s["mass_die"]) / density))
+        air, density = case_air_results(case, props, opening, out, s)
+        res.update(air)
         res["shoeBedWeightPerArea"] = {"value": round(poured * 9.81 / (np.pi * radius**2), 3), "unit": "Pa",
                                        "description": "weight of the powder in the shoe over the shoe's "
                                                       "cross-section (the shoe and the die have one radius)"}
