@@ -115,12 +115,11 @@ TEST(FusedDrift, ReportsAParticleThatLeavesTheDomainBoxOrIsNotFinite) {
     list.build(randomParticles(9));
     auto drift = [&](dem::ParticleStore p, const Vec3& lo, const Vec3& hi, bool test, int threads) {
         ThreadCount scope(threads);
+        const dem::AxisAlignedBox box{lo, hi};
         dem::DriftExtras extras;
         extras.displacementFrom = list.positionsAtBuild().data();
         extras.limitSquared = list.rebuildDisplacementSquared();
-        extras.testDomain = test;
-        extras.domainMin = lo;
-        extras.domainMax = hi;
+        extras.domain = test ? &box : nullptr;
         return dem::kickKickAndDrift(p, 1e-4, p.size(), extras).leftDomain;
     };
     // Positions within [-0.1, 0.1] + 0.5 m/s x 1e-4 s: inside a box of +-0.2.

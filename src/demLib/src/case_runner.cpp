@@ -122,11 +122,9 @@ std::string CaseRunner::latestRestart() const {
 }
 
 void CaseRunner::performDueInsertions() {
-    while (insertionsDone_ < setup_.insertions.size()) {
+    while (insertionDueAt(simulation_->time())) {
         const InsertionSpec& spec = setup_.insertions[insertionsDone_];
         const double now = simulation_->time();
-        if (spec.time > now + 1e-12) break;
-        if (placed_ > 0 && now < nextWaveTime_ - 1e-12) break;  // the last wave is still settling
         if (placed_ == 0) population_ = drawPopulation(spec);
         const ParticleStore& p = simulation_->particles();
         const std::size_t before = p.size();
@@ -203,21 +201,25 @@ void CaseRunner::writeRestart() {
     lastRestartStep_ = simulation_->stepCount();
 }
 
+bool CaseRunner::intervalDue(double interval, long next, double t) const {
+    return interval > 0.0 && t >= next * interval - 0.5 * simulation_->timeStep();
+}
+
 void CaseRunner::writeDueOutput(bool force) {
     const double t = simulation_->time();
     const double eps = 0.5 * simulation_->timeStep();
     const OutputSpec& o = setup_.output;
     const long step = simulation_->stepCount();
-    if ((o.fieldInterval > 0.0 && t >= nextField_ * o.fieldInterval - eps) || (force && lastFieldStep_ != step)) {
+    if (intervalDue(o.fieldInterval, nextField_, t) || (force && lastFieldStep_ != step)) {
         fields_->write(*simulation_);
         lastFieldStep_ = step;
         nextField_ = firstIndexAfter(t + eps, o.fieldInterval);
     }
-    if ((o.logInterval > 0.0 && t >= nextLog_ * o.logInterval - eps) || (force && lastLogStep_ != step)) {
+    if (intervalDue(o.logInterval, nextLog_, t) || (force && lastLogStep_ != step)) {
         writeSummaryLine();
         nextLog_ = firstIndexAfter(t + eps, o.logInterval);
     }
-    if (o.restartInterval > 0.0 && t >= nextRestart_ * o.restartInterval - eps) {
+    if (intervalDue(o.restartInterval, nextRestart_, t)) {
         writeRestart();
         nextRestart_ = firstIndexAfter(t + eps, o.restartInterval);
     }
@@ -246,15 +248,13 @@ void CaseRunner::progress(bool force) {
 bool CaseRunner::insertionDueAt(double now) const {
     if (insertionsDone_ >= setup_.insertions.size()) return false;
     if (setup_.insertions[insertionsDone_].time > now + 1e-12) return false;
-    return !(placed_ > 0 && now < nextWaveTime_ - 1e-12);
+    return !(placed_ > 0 && now < nextWaveTime_ - 1e-12);  // the last wave is still settling
 }
 
 bool CaseRunner::outputDueAt(double t) const {
-    const double eps = 0.5 * simulation_->timeStep();
     const OutputSpec& o = setup_.output;
-    return (o.fieldInterval > 0.0 && t >= nextField_ * o.fieldInterval - eps) ||
-           (o.logInterval > 0.0 && t >= nextLog_ * o.logInterval - eps) ||
-           (o.restartInterval > 0.0 && t >= nextRestart_ * o.restartInterval - eps);
+    return intervalDue(o.fieldInterval, nextField_, t) || intervalDue(o.logInterval, nextLog_, t) ||
+           intervalDue(o.restartInterval, nextRestart_, t);
 }
 
 void CaseRunner::advanceTo(double time) {

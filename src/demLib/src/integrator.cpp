@@ -36,9 +36,7 @@ DriftReport advance(ParticleStore& p, double dt, std::size_t count, const DriftE
     const Vec3* from = extras.displacementFrom;
     const double limit2 = extras.limitSquared;
     const Vec3 g = extras.gravity;
-    const bool testDomain = extras.testDomain;
-    const auto lo = extras.domainMin.array();
-    const auto hi = extras.domainMax.array();
+    const AxisAlignedBox* domain = extras.domain;
     const ParticleStore& cp = p;  // reads of externalForce must not allocate it
     const bool external = cp.externalForce.allocated();
     bool moved = false;
@@ -56,9 +54,7 @@ DriftReport advance(ParticleStore& p, double dt, std::size_t count, const DriftE
         if constexpr (drift) p.position[i] += dt * p.velocity[i];
         if constexpr (watch) {
             moved = moved || (p.position[i] - from[i]).squaredNorm() > limit2;
-            // AxisAlignedBox::contains and allFinite, as Simulation::removeLostParticles tests.
-            const auto x = p.position[i].array();
-            if (testDomain) left = left || !((x >= lo).all() && (x <= hi).all()) || !p.position[i].allFinite();
+            if (domain) left = left || domain->loses(p.position[i]);
         }
         if constexpr (reset) {
             p.force[i] = bodyForce(cp, i, g, external);

@@ -209,9 +209,7 @@ void Simulation::removeLostParticles(bool knownNoneLost) {
     if (!settings_.domain || knownNoneLost) return;
     // With a decomposition each rank removes its own particles; ghosts are
     // dropped first (their owners remove them), so the lists are empty below.
-    const auto isLost = [&](std::size_t i) {
-        return !settings_.domain->contains(particles_.position[i]) || !particles_.position[i].allFinite();
-    };
+    const auto isLost = [&](std::size_t i) { return settings_.domain->loses(particles_.position[i]); };
     if (decomposition_) {
         const std::size_t owned = ownedCount();
         std::size_t i = 0;
@@ -431,11 +429,7 @@ void Simulation::step(long steps) {
         }
         extras.resetForces = fused;
         extras.gravity = settings_.gravity;
-        if (extras.displacementFrom && settings_.domain) {
-            extras.testDomain = true;
-            extras.domainMin = settings_.domain->min;
-            extras.domainMax = settings_.domain->max;
-        }
+        if (extras.displacementFrom && settings_.domain) extras.domain = &*settings_.domain;
         return extras;
     };
     bool drifted = false;
@@ -447,7 +441,7 @@ void Simulation::step(long steps) {
         drifting = twoKicks ? kickKickAndDrift(particles_, dt, ownedCount(), extras)
                             : kickAndDrift(particles_, dt, ownedCount(), extras);
         watched = extras.displacementFrom != nullptr;
-        domainTested = extras.testDomain;
+        domainTested = extras.domain != nullptr;
     };
     for (long s = 0; s < steps; ++s) {
         if (!forcesValid_) {

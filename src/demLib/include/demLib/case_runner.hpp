@@ -41,6 +41,8 @@ private:
     // line, which is checked between calls, on time).
     static constexpr long maxStepsPerCall = 100;
 
+    // Is output of this interval due at time t, the next one being number `next`?
+    bool intervalDue(double interval, long next, double t) const;
     bool insertionDueAt(double time) const;  // would performDueInsertions insert at this time?
     bool outputDueAt(double time) const;     // would writeDueOutput(false) write at this time?
     void performDueInsertions();

@@ -2,6 +2,7 @@
 // Velocity-Verlet integration of translation and rotation of spheres (second
 // order; the same split as LIGGGHTS' fix nve/sphere): a half kick and a drift
 // before the forces are computed, a second half kick after.
+#include "demLib/axis_aligned_box.hpp"
 #include "demLib/particle_store.hpp"
 
 namespace dem {
@@ -20,17 +21,16 @@ struct DriftExtras {
     // the contacts to it).
     bool resetForces = false;
     Vec3 gravity = Vec3::Zero();
-    // With the rebuild test: also report whether a particle ends outside the
-    // box [domainMin, domainMax] or not finite (the engine's lost-particle
-    // test, which then need not pass over the particles again).
-    bool testDomain = false;
-    Vec3 domainMin = Vec3::Zero(), domainMax = Vec3::Zero();
+    // With the rebuild test: also report whether a particle is lost from this
+    // domain (AxisAlignedBox::loses; null: no test), so that the engine's
+    // lost-particle test need not pass over the particles again.
+    const AxisAlignedBox* domain = nullptr;
 };
 
 // What the drift's extras found.
 struct DriftReport {
     bool movedFar = false;    // a particle moved beyond the rebuild limit
-    bool leftDomain = false;  // a particle is outside the domain box or not finite
+    bool leftDomain = false;  // a particle is lost from the domain (AxisAlignedBox::loses)
 };
 
 // v += dt/2 F/m, ω += dt/2 T/I, then x += dt v, for particles 0 .. count-1

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "demLib/axis_aligned_box.hpp"
 #include "demLib/contact_force_kernel.hpp"
 #include "demLib/ghost_exchange.hpp"
 #include "demLib/insertion.hpp"
@@ -20,14 +21,6 @@
 #include "demLib/wall.hpp"
 
 namespace dem {
-
-struct AxisAlignedBox {
-    Vec3 min = Vec3::Zero();
-    Vec3 max = Vec3::Zero();
-    bool contains(const Vec3& x) const {
-        return (x.array() >= min.array()).all() && (x.array() <= max.array()).all();
-    }
-};
 
 struct SimulationSettings {
     double timeStep = 1e-5;
