@@ -1,17 +1,21 @@
 // The MPI design of demLib, checked in one process: the communicator (serial
-// fallback; refusal to run over MPI that the caller did not initialise), slab
-// geometry, and the decomposed code path (id-keyed history stash, migration
-// bookkeeping, owned/ghost split) on one rank, which must reproduce the plain
-// serial engine bit for bit.  The multi-rank checks are in
-// mpi/test_mpi_decomposition.cpp (run under mpirun).
+// fallback; refusal to run over MPI that the caller did not initialise; ranks
+// as threads), slab geometry, and the decomposed code path (id-keyed history
+// stash, migration bookkeeping, owned/ghost split) on one rank, which must
+// reproduce the plain serial engine bit for bit, and on 2 and 3 thread ranks,
+// which must follow it (decomposition_checks.hpp, also run on MPI ranks by
+// mpi/test_mpi_decomposition.cpp under mpirun).
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <limits>
+#include <stdexcept>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "decomposition_cases.hpp"
+#include "decomposition_checks.hpp"
 #include "demLib/communicator.hpp"
 #include "demLib/domain_decomposition.hpp"
 #include "demLib/error.hpp"
@@ -157,6 +161,54 @@ TEST(Decomposition, OneRankReproducesTheSerialEngineBitwise) {
             ++differ;
     }
     EXPECT_EQ(differ, 0u) << "particles whose state differs from the serial run";
+}
+
+// Ranks that are threads of this process: the same collectives as MPI's,
+// for 1 to 4 ranks, many times over (the slots of two phases alternate).
+TEST(ThreadRanks, CollectivesGiveEveryRankTheSameResults) {
+    for (int ranks = 1; ranks <= 4; ++ranks) {
+        std::atomic<int> seen{0};
+        dem::Communicator::runThreadGroup(ranks, [&](const dem::Communicator& c) {
+            EXPECT_TRUE(c.usesThreads());
+            EXPECT_FALSE(c.usesMpi());
+            EXPECT_EQ(c.size(), ranks);
+            seen += 1 << c.rank();
+            for (int round = 0; round < 50; ++round) {
+                decomposition_checks::collectivesAgree(c);
+                // A rank that runs ahead must not change what a slower one
+                // still reads: values change with every call.
+                const double mine = round * 100.0 + c.rank();
+                EXPECT_EQ(c.max(mine), round * 100.0 + ranks - 1);
+                EXPECT_EQ(c.sum(static_cast<std::int64_t>(round)), std::int64_t{round} * ranks);
+            }
+        });
+        EXPECT_EQ(seen.load(), (1 << ranks) - 1) << "each rank ran once";
+    }
+    EXPECT_THROW(dem::Communicator::runThreadGroup(0, [](const dem::Communicator&) {}), dem::InputError);
+}
+
+// A rank that fails releases the others from their collective with an error,
+// and the first exception reaches the caller after all threads ended.
+TEST(ThreadRanks, AFailingRankStopsTheGroupWithItsError) {
+    try {
+        dem::Communicator::runThreadGroup(3, [](const dem::Communicator& c) {
+            if (c.rank() == 1) throw std::runtime_error("rank 1 failed on purpose");
+            c.sum(1.0);  // waits for rank 1 forever without the release
+        });
+        FAIL() << "expected the error of rank 1";
+    } catch (const std::runtime_error& e) {
+        EXPECT_STREQ(e.what(), "rank 1 failed on purpose");
+    }
+}
+
+TEST(ThreadRanks, GhostsGiveTheSerialContactForces) {
+    for (int ranks : {2, 3})
+        dem::Communicator::runThreadGroup(ranks, decomposition_checks::ghostsGiveTheSerialContactForces);
+}
+
+TEST(ThreadRanks, MultiStepRunFollowsTheSerialRun) {
+    for (int ranks : {2, 3})
+        dem::Communicator::runThreadGroup(ranks, decomposition_checks::multiStepRunFollowsTheSerialRun);
 }
 
 }  // namespace

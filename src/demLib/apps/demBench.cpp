@@ -8,13 +8,16 @@
 //       PREFIX.bed (text: "x y z radius" per particle, the input of both demLib
 //       and LIGGGHTS timing runs) and PREFIX.restart.h5.
 //
-//   demBench time -case DIR -bed FILE -steps K [-threads N] [-sample S]
+//   demBench time -case DIR -bed FILE -steps K [-threads N | -ranks R] [-sample S]
 //       Inserts the bed at rest (no contact history, exactly what LIGGGHTS gets
 //       from read_data), applies the case's waterContent for the capillary
 //       model, takes one untimed step (first pair list and forces, like the
 //       LIGGGHTS 'run' setup) and times K steps.  Prints 'sample' lines (step,
 //       coordination number, kinetic energy) every S steps and 'result' lines
-//       (key value) that bench/run parses.
+//       (key value) that bench/run parses.  -ranks R: the bed on R ranks of the
+//       domain decomposition that are threads of this process (each rank its
+//       own slab and arrays, docs/engine.md), instead of N OpenMP threads on one
+//       simulation; dry beds only (the decomposition has no capillary model).
 //
 //   demBench copies -case DIR -bed FILE -steps K [-copies C]
 //       C independent simulations of the bed at once, each on its own thread
@@ -33,6 +36,8 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <limits>
+#include <memory>
 #include <map>
 #include <random>
 #include <sstream>
@@ -45,7 +50,9 @@
 #endif
 
 #include "demLib/case_setup.hpp"
+#include "demLib/communicator.hpp"
 #include "demLib/error.hpp"
+#include "demLib/ghost_exchange.hpp"
 #include "demLib/simulation.hpp"
 
 #include <cstring>
@@ -354,7 +361,93 @@ int independentCopies(const Options& o) {
     return 0;
 }
 
+// Slabs along the bed's longer horizontal extent, cut where they hold equal
+// numbers of particles.
+dem::SlabDecomposition equalCountSlabs(const std::vector<dem::InsertedParticle>& bed, int ranks) {
+    dem::Vec3 lower = dem::Vec3::Constant(std::numeric_limits<double>::max());
+    dem::Vec3 upper = -lower;
+    for (const dem::InsertedParticle& q : bed) {
+        lower = lower.cwiseMin(q.position);
+        upper = upper.cwiseMax(q.position);
+    }
+    const int axis = upper.x() - lower.x() >= upper.y() - lower.y() ? 0 : 1;
+    std::vector<double> c;
+    c.reserve(bed.size());
+    for (const dem::InsertedParticle& q : bed) c.push_back(q.position[axis]);
+    std::sort(c.begin(), c.end());
+    std::vector<double> cuts;
+    for (int r = 1; r < ranks; ++r) cuts.push_back(c[c.size() * static_cast<std::size_t>(r) / static_cast<std::size_t>(ranks)]);
+    return dem::SlabDecomposition(ranks, axis, cuts);
+}
+
+// timeSteps with -ranks R: the same protocol on R thread ranks of the domain
+// decomposition; rank 0 times the steps between two collectives.
+int timeStepsOnRanks(const Options& o, int ranks) {
+    const std::string caseDir = o.get("case");
+    const dem::CaseSetup setup = dem::readCaseSetup(caseDir);
+    if (setup.waterContent > 0.0)
+        throw dem::InputError("demBench time: -ranks runs dry beds only (" + setup.propertiesFile +
+                              " sets waterContent; the domain decomposition has no capillary model)");
+    const int material = setup.insertions.empty() ? 0 : setup.insertions.front().materialIndex;
+    const long steps = static_cast<long>(o.number("steps", 1000));
+    const long sample = std::max(1L, static_cast<long>(o.number("sample", 100)));
+    const std::vector<dem::InsertedParticle> bed = readBed(o.get("bed"));
+    const dem::SlabDecomposition slabs = equalCountSlabs(bed, ranks);
+    const std::size_t n = bed.size();
+    double seconds = 0.0, kineticEnergy = 0.0;
+    long builds = 0;
+    std::int64_t ghosts = 0;
+    dem::Communicator::runThreadGroup(ranks, [&](const dem::Communicator& comm) {
+        std::unique_ptr<dem::Simulation> sim = dem::makeSimulation(setup);
+        sim->setDecomposition(std::make_shared<dem::GhostExchange>(comm, slabs));
+        sim->insert(bed, material, dem::Vec3::Zero(), "bed");
+        sim->step(1);
+        auto ownedEnergy = [&] { return comm.sum(sim->particles().kineticEnergy(sim->ownedCount())); };
+        const double e0 = ownedEnergy();
+        if (comm.rank() == 0) std::cout << "sample 0 - " << std::setprecision(8) << e0 << std::endl;
+        const long buildsBefore = sim->pairList().buildCount();
+        comm.sum(0.0);  // start together
+        const auto start = Clock::now();
+        double sampling = 0.0;
+        for (long done = 0; done < steps;) {
+            const long k = std::min(sample, steps - done);
+            sim->step(k);
+            done += k;
+            const auto t0 = Clock::now();
+            const double e = ownedEnergy();
+            if (comm.rank() == 0) std::cout << "sample " << done << " - " << e << std::endl;
+            sampling += secondsSince(t0);
+        }
+        comm.sum(0.0);  // all ranks done
+        const double elapsed = secondsSince(start) - sampling;
+        const double energy = ownedEnergy();
+        const std::int64_t ghostSum = comm.sum(static_cast<std::int64_t>(sim->decomposition()->ghostCount()));
+        if (comm.rank() == 0) {
+            seconds = elapsed;
+            kineticEnergy = energy;
+            builds = sim->pairList().buildCount() - buildsBefore;
+            ghosts = ghostSum;
+        }
+    });
+    std::cout << std::setprecision(6) << "result threads " << ranks << "\n"
+              << "result ranks " << ranks << "\n"
+              << "result particles " << n << "\n"
+              << "result ghosts " << ghosts << "\n"
+              << "result steps " << steps << "\n"
+              << "result seconds " << seconds << "\n"
+              << "result particle_steps_per_s " << static_cast<double>(n) * steps / seconds << "\n"
+              << "result list_builds " << builds << "\n"
+              << "result kinetic_energy_end " << kineticEnergy << std::endl;
+    return 0;
+}
+
 int timeSteps(const Options& o) {
+    if (o.has("ranks")) {
+        const int ranks = std::atoi(o.get("ranks").c_str());
+        if (ranks < 1) throw dem::InputError("demBench time: -ranks expects an integer >= 1, got '" + o.get("ranks") + "'");
+        if (o.has("threads")) throw dem::InputError("demBench time: give -threads or -ranks, not both");
+        return timeStepsOnRanks(o, ranks);
+    }
     const std::string caseDir = o.get("case");
     dem::CaseSetup setup = dem::readCaseSetup(caseDir);
     const int material = setup.insertions.empty() ? 0 : setup.insertions.front().materialIndex;
@@ -422,7 +515,7 @@ void usage(std::ostream& out) {
     out << "Usage: demBench settle -case DIR -out PREFIX [-threads N] [-placement rsa|lattice|bed -bed FILE]\n"
            "                       [-packing PHI]\n"
            "                       [-gravityFactor G] [-settleTime T] [-relaxTime T] [-speedTolerance V]\n"
-           "       demBench time -case DIR -bed FILE -steps K [-threads N] [-sample S]\n"
+           "       demBench time -case DIR -bed FILE -steps K [-threads N | -ranks R] [-sample S]\n"
            "       demBench copies -case DIR -bed FILE -steps K [-copies C]   (C independent 1-thread runs at once)\n"
            "Benchmark driver of bench/run; see docs/performance.md.\n";
 }

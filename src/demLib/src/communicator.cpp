@@ -1,9 +1,17 @@
 #include "demLib/communicator.hpp"
 
+#include <exception>
 #include <limits>
+#include <mutex>
 #include <string>
+#include <thread>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include "demLib/error.hpp"
+#include "demLib/thread_group.hpp"
 
 #if DEMLIB_HAS_MPI
 #include "demLib/communicator_mpi.hpp"
@@ -13,6 +21,34 @@ namespace dem {
 
 Communicator::Communicator(std::shared_ptr<const MpiHandle> mpi, int rank, int size)
     : mpi_(std::move(mpi)), rank_(rank), size_(size) {}
+
+Communicator::Communicator(std::shared_ptr<ThreadGroup> threads, int rank)
+    : threads_(std::move(threads)), rank_(rank), size_(threads_->size()) {}
+
+void Communicator::runThreadGroup(int ranks, const std::function<void(const Communicator&)>& body) {
+    auto group = std::make_shared<ThreadGroup>(ranks);
+    std::mutex errorMutex;
+    std::exception_ptr firstError;
+    auto run = [&](int rank) {
+        try {
+#ifdef _OPENMP
+            omp_set_num_threads(1);  // a new thread starts from OMP_NUM_THREADS
+#endif
+            body(Communicator(group, rank));
+        } catch (...) {
+            {
+                std::lock_guard<std::mutex> lock(errorMutex);
+                if (!firstError) firstError = std::current_exception();
+            }
+            group->abandon();
+        }
+    };
+    std::vector<std::thread> threads;
+    threads.reserve(static_cast<std::size_t>(ranks));
+    for (int r = 0; r < ranks; ++r) threads.emplace_back(run, r);
+    for (auto& t : threads) t.join();
+    if (firstError) std::rethrow_exception(firstError);
+}
 
 #if DEMLIB_HAS_MPI
 
@@ -45,39 +81,47 @@ Communicator communicatorFromMpi(MPI_Comm comm) {
 MPI_Comm mpiCommOf(const Communicator& c) { return c.mpiHandle() ? c.mpiHandle()->comm : MPI_COMM_SELF; }
 
 namespace {
+
+MPI_Datatype mpiType(double) { return MPI_DOUBLE; }
+MPI_Datatype mpiType(std::int64_t) { return MPI_INT64_T; }
+
+MPI_Op mpiOp(ReduceOp op) {
+    switch (op) {
+        case ReduceOp::sum: return MPI_SUM;
+        case ReduceOp::min: return MPI_MIN;
+        case ReduceOp::max: return MPI_MAX;
+        case ReduceOp::logicalOr: return MPI_LOR;
+    }
+    return MPI_SUM;
+}
+
+// The reduction over the ranks of an MPI or serial communicator.
 template <class T>
-T allReduce(const Communicator& c, T value, MPI_Datatype type, MPI_Op op) {
+T processReduce(const Communicator& c, T value, ReduceOp op) {
     if (!c.usesMpi() || c.size() == 1) return value;
     T result{};
-    check(MPI_Allreduce(&value, &result, 1, type, op, c.mpiHandle()->comm), "MPI_Allreduce");
+    check(MPI_Allreduce(&value, &result, 1, mpiType(value), mpiOp(op), c.mpiHandle()->comm), "MPI_Allreduce");
     return result;
 }
-}  // namespace
 
-double Communicator::sum(double v) const { return allReduce(*this, v, MPI_DOUBLE, MPI_SUM); }
-std::int64_t Communicator::sum(std::int64_t v) const { return allReduce(*this, v, MPI_INT64_T, MPI_SUM); }
-double Communicator::min(double v) const { return allReduce(*this, v, MPI_DOUBLE, MPI_MIN); }
-double Communicator::max(double v) const { return allReduce(*this, v, MPI_DOUBLE, MPI_MAX); }
-bool Communicator::anyTrue(bool v) const { return allReduce(*this, v ? 1 : 0, MPI_INT, MPI_LOR) != 0; }
-
-std::vector<std::vector<char>> Communicator::exchange(const std::vector<std::vector<char>>& sendTo) const {
-    if (static_cast<int>(sendTo.size()) != size_)
-        throw RuntimeError("demLib communicator: exchange given " + std::to_string(sendTo.size()) +
-                           " buffers; expected one per rank (" + std::to_string(size_) + ")");
-    if (!usesMpi() || size_ == 1) return sendTo;
-    const MPI_Comm comm = mpi_->comm;
+// The exchange between the ranks of an MPI or serial communicator (sizes checked).
+std::vector<std::vector<char>> processExchange(const Communicator& c, const std::vector<std::vector<char>>& sendTo) {
+    if (!c.usesMpi() || c.size() == 1) return sendTo;
+    const int size = c.size();
+    const int rank = c.rank();
+    const MPI_Comm comm = c.mpiHandle()->comm;
     // Sizes first (one integer to every rank), then only the non-empty buffers
     // travel, point to point: the data volume is that of the neighbours.
-    std::vector<long long> sendSize(size_), recvSize(size_);
-    for (int r = 0; r < size_; ++r) sendSize[r] = static_cast<long long>(sendTo[r].size());
+    std::vector<long long> sendSize(size), recvSize(size);
+    for (int r = 0; r < size; ++r) sendSize[r] = static_cast<long long>(sendTo[r].size());
     check(MPI_Alltoall(sendSize.data(), 1, MPI_LONG_LONG, recvSize.data(), 1, MPI_LONG_LONG, comm), "MPI_Alltoall");
-    std::vector<std::vector<char>> received(size_);
+    std::vector<std::vector<char>> received(size);
     std::vector<MPI_Request> requests;
-    requests.reserve(2 * size_);
-    for (int r = 0; r < size_; ++r) {
+    requests.reserve(2 * size);
+    for (int r = 0; r < size; ++r) {
         if (recvSize[r] > std::numeric_limits<int>::max() || sendSize[r] > std::numeric_limits<int>::max())
             throw RuntimeError("demLib communicator: a message of more than 2 GiB; expected smaller subdomains");
-        if (r == rank_) {
+        if (r == rank) {
             received[r] = sendTo[r];
             continue;
         }
@@ -89,8 +133,8 @@ std::vector<std::vector<char>> Communicator::exchange(const std::vector<std::vec
                   "MPI_Irecv");
         }
     }
-    for (int r = 0; r < size_; ++r) {
-        if (r == rank_ || sendSize[r] == 0) continue;
+    for (int r = 0; r < size; ++r) {
+        if (r == rank || sendSize[r] == 0) continue;
         requests.emplace_back();
         check(MPI_Isend(sendTo[r].data(), static_cast<int>(sendSize[r]), MPI_BYTE, r, exchangeTag, comm,
                         &requests.back()),
@@ -100,21 +144,38 @@ std::vector<std::vector<char>> Communicator::exchange(const std::vector<std::vec
     return received;
 }
 
-#else  // serial build: the only communicator is the one-process group
+}  // namespace
 
-double Communicator::sum(double v) const { return v; }
-std::int64_t Communicator::sum(std::int64_t v) const { return v; }
-double Communicator::min(double v) const { return v; }
-double Communicator::max(double v) const { return v; }
-bool Communicator::anyTrue(bool v) const { return v; }
+#else  // serial build: the only process-level communicator is the one-process group
 
-std::vector<std::vector<char>> Communicator::exchange(const std::vector<std::vector<char>>& sendTo) const {
-    if (sendTo.size() != 1)
-        throw RuntimeError("demLib communicator: exchange given " + std::to_string(sendTo.size()) +
-                           " buffers; expected one per rank (1)");
+namespace {
+template <class T>
+T processReduce(const Communicator&, T value, ReduceOp) {
+    return value;
+}
+std::vector<std::vector<char>> processExchange(const Communicator&, const std::vector<std::vector<char>>& sendTo) {
     return sendTo;
 }
+}  // namespace
 
 #endif
+
+template <class T>
+T Communicator::reduce(T value, ReduceOp op) const {
+    return threads_ ? threads_->reduce(rank_, value, op) : processReduce(*this, value, op);
+}
+
+double Communicator::sum(double v) const { return reduce(v, ReduceOp::sum); }
+std::int64_t Communicator::sum(std::int64_t v) const { return reduce(v, ReduceOp::sum); }
+double Communicator::min(double v) const { return reduce(v, ReduceOp::min); }
+double Communicator::max(double v) const { return reduce(v, ReduceOp::max); }
+bool Communicator::anyTrue(bool v) const { return reduce(std::int64_t{v ? 1 : 0}, ReduceOp::logicalOr) != 0; }
+
+std::vector<std::vector<char>> Communicator::exchange(const std::vector<std::vector<char>>& sendTo) const {
+    if (static_cast<int>(sendTo.size()) != size_)
+        throw RuntimeError("demLib communicator: exchange given " + std::to_string(sendTo.size()) +
+                           " buffers; expected one per rank (" + std::to_string(size_) + ")");
+    return threads_ ? threads_->exchange(rank_, sendTo) : processExchange(*this, sendTo);
+}
 
 }  // namespace dem

@@ -1,5 +1,6 @@
 #include "demLib/particle_store.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace dem {
@@ -90,9 +91,9 @@ double ParticleStore::totalMass() const {
     return m;
 }
 
-double ParticleStore::kineticEnergy() const {
+double ParticleStore::kineticEnergy(std::size_t count) const {
     double e = 0.0;
-    for (std::size_t i = 0; i < size(); ++i)
+    for (std::size_t i = 0; i < std::min(count, size()); ++i)
         e += 0.5 * mass[i] * velocity[i].squaredNorm() +
              0.5 / (1.0 / (0.4 * mass[i] * radius[i] * radius[i])) * omega[i].squaredNorm();
     return e;

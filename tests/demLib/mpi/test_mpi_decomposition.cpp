@@ -1,9 +1,7 @@
 // demLib's MPI domain decomposition against the serial engine, run under
 // mpirun (any rank count >= 1; ctest uses 2).  This program, as OpenFOAM's
 // argList would, initialises MPI itself and hands demLib MPI_COMM_WORLD.
-// Every rank also runs the serial reference on the whole bed, so the
-// comparison by global id needs no gathering.  Only EXPECTs and collective
-// summaries: a rank that stopped early would leave the others waiting.
+// The checks are in ../decomposition_checks.hpp (shared with the thread ranks).
 #include <gtest/gtest.h>
 #include <mpi.h>
 
@@ -14,7 +12,7 @@
 #include <memory>
 #include <vector>
 
-#include "../decomposition_cases.hpp"
+#include "../decomposition_checks.hpp"
 #include "../thread_count.hpp"
 #include "demLib/communicator_mpi.hpp"
 #include "demLib/ghost_exchange.hpp"
@@ -23,7 +21,7 @@
 namespace {
 
 using dem::Vec3;
-using namespace decomposition_cases;
+using namespace decomposition_checks;
 
 dem::Communicator world() { return dem::communicatorFromMpi(MPI_COMM_WORLD); }
 
@@ -35,221 +33,17 @@ TEST(MpiCommunicator, WrapsTheCallersCommunicator) {
     EXPECT_TRUE(c.usesMpi());
     EXPECT_EQ(c.rank(), rank);
     EXPECT_EQ(c.size(), size);
-    EXPECT_EQ(c.sum(static_cast<double>(rank + 1)), 0.5 * size * (size + 1));
-    EXPECT_EQ(c.sum(std::int64_t{rank}), std::int64_t{size} * (size - 1) / 2);
-    EXPECT_EQ(c.min(static_cast<double>(rank)), 0.0);
-    EXPECT_EQ(c.max(static_cast<double>(rank)), size - 1.0);
-    EXPECT_EQ(c.anyTrue(rank == size - 1), true);
-    EXPECT_EQ(c.anyTrue(false), false);
-    // Rank r sends r + 1 bytes of value (10 r + destination) to every other
-    // rank and nothing to itself but one byte.
-    std::vector<std::vector<char>> send(size);
-    for (int to = 0; to < size; ++to) send[to].assign(to == rank ? 1 : rank + 1, static_cast<char>(10 * rank + to));
-    const auto got = c.exchange(send);
-    ASSERT_EQ(static_cast<int>(got.size()), size);
-    for (int from = 0; from < size; ++from) {
-        const std::size_t expected = from == rank ? 1 : from + 1;
-        EXPECT_EQ(got[from].size(), expected) << "from rank " << from;
-        for (char b : got[from]) EXPECT_EQ(b, static_cast<char>(10 * from + rank));
-    }
+    collectivesAgree(c);
 }
 
-struct Runs {
-    dem::Simulation serial;
-    dem::Simulation decomposed;
-    std::shared_ptr<dem::GhostExchange> exchange;
-};
-
-// The serial reference and this rank's part of the decomposed run, slabs
-// along x cut between the lattice planes (and off them by `shift` lattice
-// spacings, so that cuts need not fall where the bed is sparse).
-std::unique_ptr<Runs> start(const Case& c, double shift) {
-    const dem::Communicator comm = world();
-    const double span = c.xUpper - c.xLower;
-    const double offset = shift * span / 7.0;
-    auto exchange = std::make_shared<dem::GhostExchange>(
-        comm, dem::SlabDecomposition::uniform(comm.size(), 0, c.xLower + offset, c.xUpper + offset));
-    auto runs = std::unique_ptr<Runs>(new Runs{c.make(), c.make(), exchange});
-    runs->serial.insert(c.particles, 0, Vec3::Zero());
-    setMotionById(runs->serial, c);
-    runs->decomposed.setDecomposition(exchange);
-    runs->decomposed.insert(c.particles, 0, Vec3::Zero());
-    setMotionById(runs->decomposed, c);
-    return runs;
-}
-
-// Index of each id in the serial run (ids are 0 .. N-1, never reused).
-std::vector<long> indexById(const dem::ParticleStore& p, std::size_t idCount) {
-    std::vector<long> index(idCount, -1);
-    for (std::size_t i = 0; i < p.size(); ++i) index[static_cast<std::size_t>(p.id[i])] = static_cast<long>(i);
-    return index;
-}
-
-// Largest |force| and |torque| of the serial run over all particles.
-std::pair<double, double> largestLoads(const dem::ParticleStore& p) {
-    double f = 0.0, t = 0.0;
-    for (std::size_t i = 0; i < p.size(); ++i) {
-        f = std::max(f, p.force[i].norm());
-        t = std::max(t, p.torque[i].norm());
-    }
-    return {f, t};
-}
-
-// Touching pairs of an owned particle with a ghost, i.e. across a slab face.
-std::size_t straddlingContacts(const dem::Simulation& sim) {
-    const dem::ParticleStore& p = sim.particles();
-    const auto& offsets = sim.pairList().offsets();
-    const auto& neighbors = sim.pairList().neighbors();
-    const std::size_t owned = sim.ownedCount();
-    std::size_t count = 0;
-    for (std::size_t i = 0; i < owned; ++i)
-        for (int k = offsets[i]; k < offsets[i + 1]; ++k) {
-            const int j = neighbors[k];
-            if (static_cast<std::size_t>(j) >= owned &&
-                (p.position[i] - p.position[j]).norm() < p.radius[i] + p.radius[j])
-                ++count;
-        }
-    return count;
-}
-
-// Largest force and torque deviation of the owned particles from the serial
-// run (by id), over all ranks, relative to the largest force and torque of the
-// serial bed.
-void expectLoadsMatch(const Runs& runs, const char* when) {
-    const dem::Communicator comm = world();
-    const dem::ParticleStore& ref = runs.serial.particles();
-    const dem::ParticleStore& mine = runs.decomposed.particles();
-    const std::vector<long> index = indexById(ref, static_cast<std::size_t>(runs.serial.nextId()));
-    const auto [fScale, tScale] = largestLoads(ref);
-    double fError = 0.0, tError = 0.0;
-    std::int64_t missing = 0;
-    for (std::size_t i = 0; i < runs.decomposed.ownedCount(); ++i) {
-        const long k = index[static_cast<std::size_t>(mine.id[i])];
-        if (k < 0) {
-            ++missing;
-            continue;
-        }
-        fError = std::max(fError, (mine.force[i] - ref.force[k]).norm());
-        tError = std::max(tError, (mine.torque[i] - ref.torque[k]).norm());
-    }
-    fError = comm.max(fError);
-    tError = comm.max(tError);
-    EXPECT_EQ(comm.sum(missing), 0) << when;
-    EXPECT_LE(fError, 1e-12 * fScale) << when << ": force error " << fError << " N, largest force " << fScale;
-    EXPECT_LE(tError, 1e-12 * tScale) << when << ": torque error " << tError << " N m, largest " << tScale;
-    EXPECT_EQ(comm.sum(static_cast<std::int64_t>(runs.decomposed.ownedCount())),
-              static_cast<std::int64_t>(ref.size()))
-        << when;
-    if (comm.rank() == 0)
-        std::printf("[ %s ] force error %.3e of largest %.3e N; torque error %.3e of %.3e N m\n", when, fError,
-                    fScale, tError, tScale);
-}
-
-// A bed of overlapping spheres with friction and rolling history: every
-// owned particle gets the serial run's force and torque to round-off, also
-// those whose contacts cross a slab face (computed on both sides).
 TEST(MpiDecomposition, GhostsGiveTheSerialContactForces) {
     OneThread one;
-    const dem::Communicator comm = world();
-    const Case c = overlappingBed();
-    const auto runs = start(c, 0.3);
-    runs->serial.step(1);
-    runs->decomposed.step(1);
-    const std::int64_t straddling = comm.sum(static_cast<std::int64_t>(straddlingContacts(runs->decomposed)));
-    if (comm.size() > 1) {
-        EXPECT_GT(straddling, 50) << "contacts across slab faces";
-        EXPECT_GT(comm.sum(static_cast<std::int64_t>(runs->exchange->ghostCount())), 0);
-    }
-    EXPECT_GT(runs->serial.lastStep().contacts.touchingPairs, 500u);
-    expectLoadsMatch(*runs, "after 1 step");
-    // With tangential and rolling springs loaded by 40 steps of history.
-    runs->serial.step(40);
-    runs->decomposed.step(40);
-    expectLoadsMatch(*runs, "after 41 steps");
-    if (comm.rank() == 0) std::printf("straddling contacts: %ld\n", static_cast<long>(straddling));
+    ghostsGiveTheSerialContactForces(world());
 }
 
-// A granular gas in a box open at the top: particles cross the slab faces
-// (migration with their contact history), some leave the domain; positions
-// by id follow the serial run, and no particle is lost or doubled on the way.
 TEST(MpiDecomposition, MultiStepRunFollowsTheSerialRun) {
     OneThread one;
-    const dem::Communicator comm = world();
-    const Case c = agitatedGas();
-    const auto runs = start(c, 0.0);
-    const std::size_t ids = static_cast<std::size_t>(runs->serial.nextId());
-    std::vector<int> firstOwner(ids, -1);
-    for (std::size_t i = 0; i < runs->serial.particles().size(); ++i)
-        firstOwner[runs->serial.particles().id[i]] =
-            runs->exchange->slabs().ownerOf(runs->serial.particles().position[i], 0);
-    const long steps = 600;
-    runs->serial.step(steps);
-    runs->decomposed.step(steps);
-
-    const dem::ParticleStore& ref = runs->serial.particles();
-    const dem::ParticleStore& mine = runs->decomposed.particles();
-    const std::vector<long> index = indexById(ref, ids);
-    double xError = 0.0, vError = 0.0;
-    std::int64_t unknown = 0;
-    for (std::size_t i = 0; i < runs->decomposed.ownedCount(); ++i) {
-        const long k = index[static_cast<std::size_t>(mine.id[i])];
-        if (k < 0) {
-            ++unknown;  // a particle the serial run lost or never had
-            continue;
-        }
-        xError = std::max(xError, (mine.position[i] - ref.position[k]).norm());
-        vError = std::max(vError, (mine.velocity[i] - ref.velocity[k]).norm());
-        // Particles migrate at list builds; until the next one they move less
-        // than half the skin, so they may be owned that far outside the slab.
-        EXPECT_LE(runs->exchange->slabs().distanceToSlab(comm.rank(), mine.position[i]),
-                  0.5 * runs->decomposed.pairList().skin())
-            << "particle " << mine.id[i] << " owned too far outside its slab";
-    }
-    xError = comm.max(xError);
-    vError = comm.max(vError);
-    EXPECT_EQ(comm.sum(unknown), 0);
-    EXPECT_LE(xError, 1e-9) << "largest position deviation [m]";
-    EXPECT_LE(vError, 1e-6) << "largest velocity deviation [m/s]";
-
-    // Conservation: every id the serial run still has is owned by exactly one rank.
-    std::vector<std::vector<char>> send(comm.size());
-    for (std::size_t i = 0; i < runs->decomposed.ownedCount(); ++i) {
-        const char* b = reinterpret_cast<const char*>(&mine.id[i]);
-        send[0].insert(send[0].end(), b, b + sizeof(std::int64_t));
-    }
-    const auto got = comm.exchange(send);
-    if (comm.rank() == 0) {
-        std::vector<std::int64_t> all;
-        for (const auto& buffer : got)
-            for (std::size_t at = 0; at < buffer.size(); at += sizeof(std::int64_t)) {
-                std::int64_t id;
-                std::memcpy(&id, buffer.data() + at, sizeof id);
-                all.push_back(id);
-            }
-        std::sort(all.begin(), all.end());
-        std::vector<std::int64_t> expected(ref.id.begin(), ref.id.end());
-        std::sort(expected.begin(), expected.end());
-        EXPECT_EQ(all, expected) << "global ids after the run (lost or duplicated particles)";
-    }
-    EXPECT_EQ(comm.sum(static_cast<std::int64_t>(runs->decomposed.lostCount())),
-              static_cast<std::int64_t>(runs->serial.lostCount()));
-    EXPECT_GT(runs->serial.lostCount(), 0u) << "the case should lose particles through the open top";
-
-    // The run must have exercised migration: particles now owned by another
-    // rank than at the start.
-    std::int64_t crossed = 0;
-    for (std::size_t k = 0; k < ref.size(); ++k)
-        if (runs->exchange->slabs().ownerOf(ref.position[k], 0) != firstOwner[ref.id[k]]) ++crossed;
-    const std::int64_t migrations = comm.sum(static_cast<std::int64_t>(runs->exchange->migratedCount()));
-    if (comm.size() > 1) {
-        EXPECT_GT(migrations, 20) << "particles sent to another rank";
-        EXPECT_GT(crossed, 0) << "particles that ended in another slab";
-    }
-    if (comm.rank() == 0)
-        std::printf("600 steps: position error %.3e m, velocity error %.3e m/s, %ld migrations, %ld particles "
-                    "ended in another slab, %zu lost, %ld list builds\n",
-                    xError, vError, static_cast<long>(migrations), static_cast<long>(crossed),
-                    runs->serial.lostCount(), runs->decomposed.pairList().buildCount());
+    multiStepRunFollowsTheSerialRun(world());
 }
 
 }  // namespace

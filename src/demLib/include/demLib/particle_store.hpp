@@ -74,7 +74,10 @@ public:
 
     void reserve(std::size_t n);
     double totalMass() const;
-    double kineticEnergy() const;  // translational + rotational
+    // Translational + rotational, of all particles or of the first `count`
+    // (the owned ones of a decomposed run, which stores its ghosts after them).
+    double kineticEnergy() const { return kineticEnergy(size()); }
+    double kineticEnergy(std::size_t count) const;
     // Bytes of the per-particle fields (externalForce counted once allocated).
     std::size_t bytesPerParticle() const;
 };
