@@ -288,4 +288,40 @@ TEST(ParticleParticleNeighborList, ListsPairsBeyondTouchingReachOnlyWhereABridge
     }
 }
 
+// A bed with a size ratio of 6 (the coarse-grained F32 sand has 5.6) at
+// random positions, with an extra range: the build skips the cells beyond each
+// particle's own reach (its radius + the largest + skin + extra), and must
+// still list every pair that brute force finds, small-large pairs across cell
+// faces included, and count the touching ones.  1 and 2 threads.
+TEST(ParticleParticleNeighborList, ListsEveryPairOfAWidelyPolydisperseBed) {
+    dem::ParticleStore p;
+    std::mt19937 rng(23);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    const double smallest = 0.2e-3, largest = 1.2e-3, side = 0.012;
+    for (int id = 0; id < 4000; ++id) {
+        // Log-uniform radii: most particles small, as by number in a sieve distribution.
+        const double r = smallest * std::pow(largest / smallest, u(rng));
+        p.add(id, Vec3(side * u(rng), side * u(rng), 0.5 * side * u(rng)), Vec3::Zero(), r, 2500.0, 0);
+    }
+    const double skin = 0.25e-3, extra = 0.15e-3;
+    const std::vector<std::pair<int, int>> expected = allPairs(p, skin + extra);
+    std::vector<int> touching(p.size() + 1, 0);
+    for (const auto& [i, j] : allPairs(p, 0.0)) ++touching[i + 1];
+    for (std::size_t i = 0; i < p.size(); ++i) touching[i + 1] += touching[i];
+    std::size_t smallLarge = 0;
+    for (const auto& [i, j] : expected)
+        smallLarge += std::max(p.radius[i], p.radius[j]) > 3.0 * std::min(p.radius[i], p.radius[j]);
+    ASSERT_GT(expected.size(), 10000u);
+    ASSERT_GT(smallLarge, 1000u) << "pairs of a small and a large particle";
+    ASSERT_GT(touching.back(), 1000);
+    for (int threads : {1, 2}) {
+        ThreadCount scope(threads);
+        dem::ParticleParticleNeighborList list;
+        list.setRanges(skin, extra);
+        list.build(p);
+        EXPECT_EQ(listedPairs(list), expected) << threads << " thread(s)";
+        EXPECT_EQ(list.touchingOffsets(), touching) << threads << " thread(s)";
+    }
+}
+
 }  // namespace

@@ -112,11 +112,19 @@ void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
     }
 
     // Cells at least one interaction range wide, so that only the 27
-    // surrounding cells need a look.
+    // surrounding cells need a look; and of those only the ones that the
+    // particle's own search sphere (its radius + the largest radius + the
+    // reach) touches: in a polydisperse bed the cells are sized for two of the
+    // largest particles, and a small particle reaches few of its 26 neighbour
+    // cells (the wet bench's list build 30 % faster; finer cells with a wider
+    // stencil were slower).  The rows are sorted below, so the list does not
+    // depend on which cells are visited, only on the pairs found.
     double rMax = 0.0;
     for (int i = 0; i < n; ++i) rMax = std::max(rMax, particles.radius[i]);
     CellBins bins = binIntoCells(positions, 2.0 * rMax + skin_ + extraRange_);
     const int nx = bins.nx, ny = bins.ny, nz = bins.nz;
+    const double invCell = 1.0 / bins.cellSize;
+    const Vec3 gridLower = bins.lower;
     const std::vector<int>& cellOf = bins.cellOf;
     const std::vector<int>& cellStart = bins.cellStart;
     const std::vector<int>& cellParticles = bins.particles;
@@ -170,15 +178,31 @@ void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
             const int cx = c % nx, cy = (c / nx) % ny, cz = c / (nx * ny);
             const Vec3& xi = positions[i];
             const double ri = particles.radius[i];
+            // Position and search radius in cell units (the position computed
+            // as the binning did); a cell is skipped when its gap to the
+            // position exceeds the radius, with a margin far above rounding.
+            const Vec3 at = (xi - gridLower) * invCell;
+            const double search = (ri + rMax + reach) * invCell * (1.0 + 1e-9) + 1e-9;
+            const double search2 = search * search;
+            // Gap in cell units between coordinate u (in cell k) and cell q.
+            auto gap = [](double u, int k, int q) { return q > k ? q - u : (q < k ? u - (q + 1) : 0.0); };
             for (int dz = -1; dz <= 1; ++dz) {
                 const int z = cz + dz;
                 if (z < 0 || z >= nz) continue;
+                const double gz = gap(at.z(), cz, z);
+                const double gz2 = gz * gz;
+                if (gz2 > search2) continue;
                 for (int dy = -1; dy <= 1; ++dy) {
                     const int y = cy + dy;
                     if (y < 0 || y >= ny) continue;
+                    const double gy = gap(at.y(), cy, y);
+                    const double gzy2 = gz2 + gy * gy;
+                    if (gzy2 > search2) continue;
                     for (int dx = -1; dx <= 1; ++dx) {
                         const int x = cx + dx;
                         if (x < 0 || x >= nx) continue;
+                        const double gx = gap(at.x(), cx, x);
+                        if (gzy2 + gx * gx > search2) continue;
                         const int cc = (z * ny + y) * nx + x;
                         for (int k = cellStart[cc]; k < cellStart[cc + 1]; ++k) {
                             const int j = cellParticles[k];
