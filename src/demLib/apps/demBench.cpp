@@ -34,6 +34,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <iomanip>
 #include <iostream>
 #include <limits>
@@ -361,6 +362,25 @@ int independentCopies(const Options& o) {
     return 0;
 }
 
+// Advances `steps` steps in calls of `sample` steps, calling onSample(done)
+// after each; returns the seconds spent stepping (the samples not counted).
+// settle(), if given, runs after each call inside the timed interval (thread
+// ranks: a barrier, so that the time is that of the slowest rank).
+double timedSteps(dem::Simulation& sim, long steps, long sample, const std::function<void(long)>& onSample,
+                  const std::function<void()>& settle = {}) {
+    double stepping = 0.0;
+    for (long done = 0; done < steps;) {
+        const long k = std::min(sample, steps - done);
+        const auto t0 = Clock::now();
+        sim.step(k);
+        if (settle) settle();
+        stepping += secondsSince(t0);
+        done += k;
+        onSample(done);
+    }
+    return stepping;
+}
+
 // Slabs along the bed's longer horizontal extent, cut where they hold equal
 // numbers of particles.
 dem::SlabDecomposition equalCountSlabs(const std::vector<dem::InsertedParticle>& bed, int ranks) {
@@ -407,19 +427,13 @@ int timeStepsOnRanks(const Options& o, int ranks) {
         if (comm.rank() == 0) std::cout << "sample 0 - " << std::setprecision(8) << e0 << std::endl;
         const long buildsBefore = sim->pairList().buildCount();
         comm.sum(0.0);  // start together
-        const auto start = Clock::now();
-        double sampling = 0.0;
-        for (long done = 0; done < steps;) {
-            const long k = std::min(sample, steps - done);
-            sim->step(k);
-            done += k;
-            const auto t0 = Clock::now();
-            const double e = ownedEnergy();
-            if (comm.rank() == 0) std::cout << "sample " << done << " - " << e << std::endl;
-            sampling += secondsSince(t0);
-        }
-        comm.sum(0.0);  // all ranks done
-        const double elapsed = secondsSince(start) - sampling;
+        const double elapsed = timedSteps(
+            *sim, steps, sample,
+            [&](long done) {
+                const double e = ownedEnergy();
+                if (comm.rank() == 0) std::cout << "sample " << done << " - " << e << std::endl;
+            },
+            [&] { comm.sum(0.0); });
         const double energy = ownedEnergy();
         const std::int64_t ghostSum = comm.sum(static_cast<std::int64_t>(sim->decomposition()->ghostCount()));
         if (comm.rank() == 0) {
@@ -469,20 +483,12 @@ int timeSteps(const Options& o) {
     double coordinationSum = 0.0;
     int samples = 0;
     const long buildsBefore = sim->pairList().buildCount();
-    const auto start = Clock::now();
-    double sampling = 0.0;
-    for (long done = 0; done < steps;) {
-        const long k = std::min(sample, steps - done);
-        sim->step(k);
-        done += k;
-        const auto t0 = Clock::now();
+    const double seconds = timedSteps(*sim, steps, sample, [&](long done) {
         coordinationSum += sim->coordinationNumber();
         ++samples;
         std::cout << "sample " << done << ' ' << sim->coordinationNumber() << ' ' << sim->particles().kineticEnergy()
                   << std::endl;
-        sampling += secondsSince(t0);
-    }
-    const double seconds = secondsSince(start) - sampling;
+    });
     const dem::ParticleStore& p = sim->particles();
 
     std::cout << std::setprecision(6);
