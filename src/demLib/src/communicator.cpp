@@ -45,7 +45,15 @@ void Communicator::runThreadGroup(int ranks, const std::function<void(const Comm
     };
     std::vector<std::thread> threads;
     threads.reserve(static_cast<std::size_t>(ranks));
-    for (int r = 0; r < ranks; ++r) threads.emplace_back(run, r);
+    try {
+        for (int r = 0; r < ranks; ++r) threads.emplace_back(run, r);
+    } catch (...) {
+        // A thread could not be started: the started ranks would wait for it
+        // in their first collective forever.
+        group->abandon();
+        for (auto& t : threads) t.join();
+        throw;
+    }
     for (auto& t : threads) t.join();
     if (firstError) std::rethrow_exception(firstError);
 }

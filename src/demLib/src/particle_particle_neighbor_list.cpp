@@ -116,7 +116,7 @@ void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
     // particle's own search sphere (its radius + the largest radius + the
     // reach) touches: in a polydisperse bed the cells are sized for two of the
     // largest particles, and a small particle reaches few of its 26 neighbour
-    // cells (the wet bench's list build 30 % faster; finer cells with a wider
+    // cells (the wet bench's list build 27 % faster; finer cells with a wider
     // stencil were slower).  The rows are sorted below, so the list does not
     // depend on which cells are visited, only on the pairs found.
     double rMax = 0.0;
