@@ -10,6 +10,8 @@
 #include <sstream>
 #include <string>
 
+#include <unistd.h>
+
 #include "demLib/case_runner.hpp"
 #include "demLib/case_setup.hpp"
 #include "demLib/simulation.hpp"
@@ -115,7 +117,9 @@ Finished run(const fs::path& dir, bool oneStepPerCall) {
 
 void expectSameRuns(int threads) {
     ThreadCount scope(threads);
-    const fs::path base = fs::temp_directory_path() / ("demlib_chunks_" + std::to_string(threads));
+    // Per process and thread count: two test runs on one machine must not share it.
+    const fs::path base = fs::temp_directory_path() /
+                          ("demlib_chunks_" + std::to_string(::getpid()) + "_" + std::to_string(threads));
     const Finished chunked = run(base / "chunked", false);
     const Finished single = run(base / "single", true);
     const dem::ParticleStore& a = chunked.runner->simulation().particles();
