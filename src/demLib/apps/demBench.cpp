@@ -401,7 +401,7 @@ dem::SlabDecomposition equalCountSlabs(const std::vector<dem::InsertedParticle>&
 }
 
 // timeSteps with -ranks R: the same protocol on R thread ranks of the domain
-// decomposition; rank 0 times the steps between two collectives.
+// decomposition; rank 0 times each call of steps up to a barrier (timedSteps).
 int timeStepsOnRanks(const Options& o, int ranks) {
     const std::string caseDir = o.get("case");
     const dem::CaseSetup setup = dem::readCaseSetup(caseDir);
