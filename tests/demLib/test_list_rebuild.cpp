@@ -32,24 +32,22 @@ TEST(ContactHistoryPool, RepackPermutesTheRecordsInPlaceInListOrder) {
     dem::ContactHistoryPool pool;
     pool.reset(6);
     // Slots taken out of list order (as contacts close during a run), one
-    // returned: records 0..4 hold entries 4, 2, 0, 5, 1; entry 5's is freed.
+    // resting: records 0..4 hold entries 4, 2, 0, 5, 1; entry 5's contact opened.
     for (int k : {4, 2, 0, 5, 1}) pool.set(k, history(k + 1.0, 10.0 * (k + 1)));
-    std::vector<dem::ContactHistoryPool::Changes> changes(1);
-    changes[0].released.push_back(pool.slots()[5]);
-    pool.slots()[5] = -1;
-    pool.commit(changes);
-    ASSERT_EQ(pool.slotsInUse(), 4u);
+    pool.open(5);
+    ASSERT_EQ(pool.contactsWithHistory(), 4u);
+    ASSERT_EQ(pool.records(), 5u);
     const double* recordsBefore = pool.record(0);
 
     // New list of 5 entries: old entries 1, 4 and 0 continue (in that order),
     // entry 1 is a new pair already in contact, entry 3 a new pair apart; old
-    // entry 2 left the list.
+    // entry 2 left the list, old entry 5's resting record is dropped.
     const std::vector<int> oldSlots(pool.slots(), pool.slots() + 6);
     std::vector<int> source{oldSlots[1], dem::ContactHistoryPool::freshRecord, oldSlots[4], -1, oldSlots[0]};
     pool.repack(source);
     EXPECT_EQ(source, oldSlots);  // the old slot array comes back as a buffer
     EXPECT_EQ(pool.entries(), 5u);
-    EXPECT_EQ(pool.slotsInUse(), 4u);
+    EXPECT_EQ(pool.records(), 4u);
     EXPECT_EQ(pool.record(0), recordsBefore);  // same memory: no second copy of the records
     // Slots in list order, the records moved with them.
     EXPECT_EQ(pool.slots()[0], 0);
@@ -69,7 +67,7 @@ TEST(ContactHistoryPool, RepackPermutesTheRecordsInPlaceInListOrder) {
     grow[6] = 2;  // old entry 2 (history 5, 50)
     grow[0] = 0;  // old entry 0 (history 2, 20)
     pool.repack(grow);
-    EXPECT_EQ(pool.slotsInUse(), 8u);
+    EXPECT_EQ(pool.records(), 8u);
     expectHistory(pool.get(0), history(2.0, 20.0));
     expectHistory(pool.get(6), history(5.0, 50.0));
     for (int k : {1, 2, 3, 4, 5, 7}) expectHistory(pool.get(k), history(0.0, 0.0));

@@ -21,31 +21,39 @@ using dem_testing::history;
 TEST(ContactHistoryPool, SlotsOnlyForPairsWithHistory) {
     dem::ContactHistoryPool pool;
     pool.reset(4);
-    EXPECT_EQ(pool.slotsInUse(), 0u);
+    EXPECT_EQ(pool.records(), 0u);
     pool.set(1, history(1.0, 10.0));
     pool.set(3, history(3.0, 30.0));
-    EXPECT_EQ(pool.slotsInUse(), 2u);
+    EXPECT_EQ(pool.records(), 2u);
     expectHistory(pool.get(0), history(0.0, 0.0));
     expectHistory(pool.get(1), history(1.0, 10.0));
     expectHistory(pool.get(3), history(3.0, 30.0));
 
-    // A force loop: pair 1 opened (slot returned), pair 2 closed (new history).
+    // A force loop: pair 1 opened (its record rests), pair 2 closed (new history).
+    const int rested = pool.slots()[1];
+    pool.open(1);
+    EXPECT_TRUE(dem::ContactHistoryPool::isResting(pool.slots()[1]));
     std::vector<dem::ContactHistoryPool::Changes> changes(2);
-    const int freed = pool.slots()[1];
-    pool.slots()[1] = -1;
-    changes[0].released.push_back(freed);
     changes[1].opened.push_back({2, history(2.0, 20.0)});
     pool.commit(changes);
-    EXPECT_EQ(pool.slotsInUse(), 2u);
-    EXPECT_EQ(pool.slots()[2], freed);  // the returned slot is reused, the pool does not grow
+    EXPECT_EQ(pool.contactsWithHistory(), 2u);
+    EXPECT_EQ(pool.records(), 3u);  // the resting record is kept until the next build
     expectHistory(pool.get(1), history(0.0, 0.0));
     expectHistory(pool.get(2), history(2.0, 20.0));
+    // Pair 1 touches again: it takes its own record back, the pool does not grow.
+    pool.set(1, history(4.0, 40.0));
+    EXPECT_EQ(pool.slots()[1], rested);
+    EXPECT_EQ(pool.records(), 3u);
+    expectHistory(pool.get(1), history(4.0, 40.0));
+    pool.open(1);
 
     // A list rebuild: new entry 0 is old pair 3 seen from its other particle,
-    // entry 1 is new, entry 2 is new but already touching, entry 3 is old pair 2.
-    pool.rebuild({3, -1, -1, 2}, {1, 0, 0, 0}, {0, 0, 1, 0});
+    // entry 1 continues old pair 1 (resting: no history), entry 2 is new but
+    // already touching, entry 3 is old pair 2.
+    pool.rebuild({3, 1, -1, 2}, {1, 0, 0, 0}, {0, 0, 1, 0});
     EXPECT_EQ(pool.entries(), 4u);
-    EXPECT_EQ(pool.slotsInUse(), 3u);
+    EXPECT_EQ(pool.records(), 3u);  // the resting record is dropped
+    EXPECT_EQ(pool.contactsWithHistory(), 3u);
     expectHistory(pool.get(0), history(-3.0, -30.0));
     EXPECT_EQ(pool.slots()[1], -1);
     EXPECT_GE(pool.slots()[2], 0);
@@ -63,8 +71,10 @@ TEST(ContactHistoryPool, SlotsOnlyForPairsWithHistory) {
     expectHistory(pool.get(3), dem::ContactHistory{history(2.0, 0.0).shear, Vec3::Zero()});
 }
 
-dem::Simulation twoTouchingAndOneNear(dem::RollingModel rolling, dem::CohesionModel cohesion) {
+dem::Simulation twoTouchingAndOneNear(dem::RollingModel rolling, dem::CohesionModel cohesion,
+                                      bool vectorizedPairLaw = true) {
     dem::SimulationSettings s;
+    s.forces.vectorizedPairLaw = vectorizedPairLaw;
     s.timeStep = 1e-6;
     s.gravity = Vec3::Zero();
     s.forces.rolling = rolling;
@@ -98,7 +108,7 @@ TEST(PairStateMemory, HistoryOnlyForTouchingPairsAndOnlyTheModelsParts) {
     EXPECT_TRUE(list.bridgeVolume().empty());
     ASSERT_EQ(list.pairCount(), 2u);  // (0,1) touching and (1,2) within the skin
     EXPECT_EQ(sim.lastStep().contacts.touchingPairs, 1u);
-    EXPECT_EQ(list.history().slotsInUse(), 1u);
+    EXPECT_EQ(list.history().contactsWithHistory(), 1u);
     const dem::PairState touching = list.state()[0];  // pair (0, 1)
     const dem::PairState near = list.state()[1];      // pair (1, 2)
     // Particle 0 moves +y relative to 1: the tangential spring stretches along +y.
@@ -126,14 +136,35 @@ TEST(PairStateMemory, HistoryOnlyForTouchingPairsAndOnlyTheModelsParts) {
     EXPECT_EQ(wet.pairList().bridgeVolume().size(), wet.pairList().pairCount());
 }
 
-TEST(PairStateMemory, ContactThatOpensReturnsItsSlot) {
-    ThreadCount threads(1);
-    dem::Simulation sim = twoTouchingAndOneNear(dem::RollingModel::EPSD2, dem::CohesionModel::None);
-    sim.particles().velocity[0] = Vec3(-0.05, 0, 0);  // 0 leaves 1: 1 um in 20 us
-    sim.step(100);
-    EXPECT_EQ(sim.lastStep().contacts.touchingPairs, 0u);
-    EXPECT_EQ(sim.pairList().history().slotsInUse(), 0u);
-    for (const dem::PairState& s : sim.pairList().state()) EXPECT_EQ(s.contact.shear, Vec3::Zero());
+TEST(PairStateMemory, ContactThatOpensForgetsItsHistoryAndTakesItsRecordBackWhenItCloses) {
+    for (const bool batched : {true, false}) {
+        SCOPED_TRACE(batched ? "law in vector lanes" : "law per pair");
+        ThreadCount threads(1);
+        dem::Simulation sim = twoTouchingAndOneNear(dem::RollingModel::EPSD2, dem::CohesionModel::None, batched);
+        sim.step(5);
+        const dem::ContactHistoryPool& pool = sim.pairList().history();
+        ASSERT_EQ(pool.contactsWithHistory(), 1u);
+        const int record = pool.slot(0);
+        ASSERT_GE(record, 0);
+        sim.particles().velocity[0] = Vec3(-0.05, 0, 0);  // 0 leaves 1: 1 um in 20 us
+        sim.step(100);
+        EXPECT_EQ(sim.lastStep().contacts.touchingPairs, 0u);
+        EXPECT_EQ(pool.contactsWithHistory(), 0u);
+        for (const dem::PairState& s : sim.pairList().state()) EXPECT_EQ(s.contact.shear, Vec3::Zero());
+        EXPECT_EQ(sim.pairList().buildCount(), 1);  // still the first list: the record rests
+        EXPECT_EQ(pool.slot(0), dem::ContactHistoryPool::resting(record));
+
+        // Back into contact before the next build: the pair's springs start from
+        // zero again, in its own record (the pool does not grow).
+        sim.particles().velocity[0] = Vec3(0.05, 0.01, 0);
+        for (int n = 0; n < 300 && sim.lastStep().contacts.touchingPairs == 0; ++n) sim.step(1);
+        ASSERT_EQ(sim.lastStep().contacts.touchingPairs, 1u);
+        sim.step(5);
+        EXPECT_EQ(sim.pairList().buildCount(), 1);
+        EXPECT_EQ(pool.slot(0), record);
+        EXPECT_EQ(pool.records(), 1u);
+        EXPECT_GT(sim.pairList().state()[0].contact.shear.norm(), 0.0);
+    }
 }
 
 TEST(ExternalForceField, AllocatedOnFirstWriteAndFollowsTheParticles) {

@@ -234,12 +234,17 @@ private:
     }
 
     // A contact that opens forgets its springs (LIGGGHTS surfacesClose): its
-    // history slot goes back to the pool.
-    static void forgetSprings(int* slot, int k, ContactHistoryPool::Changes& changes) {
-        if (slot[k] >= 0) {
-            changes.released.push_back(slot[k]);
-            slot[k] = -1;
-        }
+    // record rests until the next list build, and the pair takes it back if it
+    // touches again (ContactHistoryPool).
+    static DEM_ALWAYS_INLINE void forgetSprings(int* slot, int k) {
+        if (slot[k] >= 0) slot[k] = ContactHistoryPool::resting(slot[k]);
+    }
+    // The record of a contact that touches again after resting, or null (a new
+    // contact: its history goes to the pool's new records after the loop).
+    static DEM_ALWAYS_INLINE double* recordToWrite(int* slot, int k, double* records, std::size_t stride) {
+        int s = slot[k];
+        if (ContactHistoryPool::isResting(s)) slot[k] = s = ContactHistoryPool::restingRecord(s);
+        return s >= 0 ? records + s * stride : nullptr;
     }
 
     // The capillary force of a bridge between spheres of radii r1, r2 (a wall:
@@ -296,7 +301,7 @@ private:
                 const double dist2 = d.squaredNorm();
                 if constexpr (Cohesion == CohesionModel::None) {
                     if (dist2 >= radiusSum * radiusSum) {
-                        forgetSprings(slot, k, changes);
+                        forgetSprings(slot, k);
                         continue;
                     }
                 }
@@ -309,7 +314,7 @@ private:
                     cohesiveForce = pairBridgeForce(bridge[k], fits[k], listVersion, overlap, ri, rj, stats.bridges,
                                                     stats.releasedLiquid);
                     if (overlap <= 0.0) {
-                        forgetSprings(slot, k, changes);
+                        forgetSprings(slot, k);
                         if (cohesiveForce != 0.0) {
                             const Vec3 f = cohesiveForce * normal;
                             fi += f;
@@ -348,9 +353,9 @@ private:
                 }
                 const ContactForces f =
                     Law::evaluate(kin, interactions(p.material[i], p.material[j]), history, cohesiveForce);
-                if (record) {
-                    Vec3::Map(record) = history.shear;
-                    if constexpr (keepsRolling) Vec3::Map(record + 3) = history.rollingTorque;
+                if (double* out = record ? record : recordToWrite(slot, k, records, stride)) {
+                    Vec3::Map(out) = history.shear;
+                    if constexpr (keepsRolling) Vec3::Map(out + 3) = history.rollingTorque;
                 } else {
                     changes.opened.push_back({k, history});
                 }
@@ -406,13 +411,13 @@ private:
                     const int e = count;
                     if constexpr (Cohesion == CohesionModel::None) {
                         const bool touching = !(dist2 >= radiusSum * radiusSum);
-                        if ((slot[k] >= 0) & !touching) forgetSprings(slot, k, changes);  // rare: a contact that opened
+                        if ((slot[k] >= 0) & !touching) forgetSprings(slot, k);  // rare: a contact that opened
                         count += touching;
                     } else {
                         // A pair without a bridge that is clearly apart needs no
                         // root (the margin keeps the root's verdict: sqrt(dist2) > R).
                         if (!(bridge[k] > 0.0) && dist2 > radiusSum * radiusSum * (1.0 + 1e-12)) {
-                            forgetSprings(slot, k, changes);
+                            forgetSprings(slot, k);
                             continue;
                         }
                         // The bridge needs the gap of every other listed pair (the
@@ -423,7 +428,7 @@ private:
                             pairBridgeForce(bridge[k], fits[k], listVersion, overlap, ri, rj, stats.bridges,
                                             stats.releasedLiquid);
                         if (overlap <= 0.0) {
-                            forgetSprings(slot, k, changes);
+                            forgetSprings(slot, k);
                             if (cohesiveForce == 0.0) continue;
                             touching = false;  // a bridge beyond contact: a force entry only
                         }
@@ -505,9 +510,7 @@ private:
                 ti += Vec3(b.tix[e], b.tiy[e], b.tiz[e]);
                 sink.onOther(j, f, Vec3(b.tjx[e], b.tjy[e], b.tjz[e]));
                 // History back to its record, or to the pool's new records after the loop.
-                const int s = slot[b.entry[e]];
-                if (s >= 0) {
-                    double* record = records + s * stride;
+                if (double* record = recordToWrite(slot, b.entry[e], records, stride)) {
                     record[0] = b.sx[e];
                     record[1] = b.sy[e];
                     record[2] = b.sz[e];

@@ -23,7 +23,6 @@ void ContactHistoryPool::setRolling(bool keep) {
 void ContactHistoryPool::reset(std::size_t entries) {
     slot_.assign(entries, -1);
     data_.clear();
-    free_.clear();
 }
 
 void ContactHistoryPool::rebuild(const std::vector<int>& from, const std::vector<char>& flip,
@@ -51,7 +50,6 @@ void ContactHistoryPool::rebuild(const std::vector<int>& from, const std::vector
     }
     slot_.swap(slot);
     data_.swap(data);
-    free_.clear();
 }
 
 void ContactHistoryPool::repack(std::vector<int>& source) {
@@ -69,8 +67,7 @@ void ContactHistoryPool::repack(std::vector<int>& source) {
     // Where each record goes: carried records to their new slot; the rest (old
     // records no entry continues, and room beyond the old records) fill the
     // fresh slots first and then the tail, which is cut off at the end.
-    // free_ is cleared by a rebuild anyway: its memory serves as the map.
-    std::vector<int>& target = free_;
+    std::vector<int>& target = map_;
     target.assign(span, -1);
     {
         int next = 0;
@@ -103,16 +100,10 @@ void ContactHistoryPool::repack(std::vector<int>& source) {
         }
     for (int s : fresh) std::fill_n(&data_[s * width], width, 0.0);
     data_.resize(static_cast<std::size_t>(used) * width);  // capacity kept: room for new contacts
-    free_.clear();
     slot_.swap(source);
 }
 
 int ContactHistoryPool::takeSlot() {
-    if (!free_.empty()) {
-        const int s = free_.back();
-        free_.pop_back();
-        return s;
-    }
     // Grow by an eighth, not the doubling of vector: the records are a large
     // part of the memory, and a copy holds the old and new block at once.
     if (data_.size() == data_.capacity()) data_.reserve(grownCapacity(slotCount()) * stride());
@@ -121,20 +112,26 @@ int ContactHistoryPool::takeSlot() {
 }
 
 void ContactHistoryPool::set(std::size_t k, const ContactHistory& h) {
-    if (slot_[k] < 0) slot_[k] = takeSlot();
+    if (isResting(slot_[k]))
+        slot_[k] = restingRecord(slot_[k]);
+    else if (slot_[k] < 0)
+        slot_[k] = takeSlot();
     double* r = record(slot_[k]);
     Vec3::Map(r) = h.shear;
     if (rolling_) Vec3::Map(r + 3) = h.rollingTorque;
 }
 
 void ContactHistoryPool::commit(const std::vector<Changes>& changes) {
-    for (const Changes& c : changes) free_.insert(free_.end(), c.released.begin(), c.released.end());
     for (const Changes& c : changes)
         for (const Changes::Opened& o : c.opened) set(o.entry, o.history);
 }
 
 std::size_t ContactHistoryPool::bytes() const {
-    return slot_.capacity() * sizeof(int) + data_.capacity() * sizeof(double) + free_.capacity() * sizeof(int);
+    return slot_.capacity() * sizeof(int) + data_.capacity() * sizeof(double) + map_.capacity() * sizeof(int);
+}
+
+std::size_t ContactHistoryPool::contactsWithHistory() const {
+    return static_cast<std::size_t>(std::count_if(slot_.begin(), slot_.end(), [](int s) { return s >= 0; }));
 }
 
 }  // namespace dem

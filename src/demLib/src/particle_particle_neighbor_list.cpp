@@ -231,7 +231,8 @@ void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
             for (const int j : mine) {
                 while (a < aEnd && oldNeighbors[a] < j) ++a;
                 const int old = a < aEnd && oldNeighbors[a] == j ? a : -1;
-                int source = old >= 0 ? oldSlots[old] : -1;
+                // A resting record (a contact that opened) is not carried.
+                int source = old >= 0 && oldSlots[old] >= 0 ? oldSlots[old] : -1;
                 if (source < 0) {
                     // Pairs in contact now get their record here, in list
                     // order; only contacts that close later take slots out of order.

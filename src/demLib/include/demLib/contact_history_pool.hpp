@@ -7,7 +7,12 @@
 // bytes of zeros.  The pools are compacted in list order at every list build
 // or reorder, so the force loop reads them nearly in sequence.
 //
-// Slots are handed out and returned between force loops (commit), in thread
+// A contact that opens keeps its record until the next list build, marked
+// resting (slot -3 - s, history zero), and takes it back if the same pair
+// touches again.  Contacts flicker in a dense bed; handing their records back
+// to a shared free list scattered the records of each force-loop thread over
+// the other's (the two cores then fought over the cache lines) and out of list
+// order.  New slots are handed out between force loops (commit), in thread
 // order: the layout depends only on the thread count, and the physics not on
 // the layout at all.
 #include <cstddef>
@@ -40,6 +45,10 @@ public:
     // `source` holds the old slot array, as a buffer for the next build.
     static constexpr int freshRecord = -2;
     void repack(std::vector<int>& source);
+    // Resting slots (see above): the slot value of resting record s, and back.
+    static constexpr bool isResting(int slot) { return slot <= -3; }
+    static constexpr int resting(int record) { return -3 - record; }
+    static constexpr int restingRecord(int slot) { return -3 - slot; }
     // Hands out the slot array (the pool then has no entries), e.g. to reuse
     // its memory once the slots were copied elsewhere.
     std::vector<int> releaseSlots() { return std::move(slot_); }
@@ -54,34 +63,38 @@ public:
         }
         return h;
     }
-    // Stores the history of entry k (a slot is taken if it has none).
+    // Stores the history of entry k (a resting record is taken back, else a
+    // slot is taken if it has none).
     void set(std::size_t k, const ContactHistory& h);
+    // Entry k's contact opened: its history is zero from now on (its record rests).
+    void open(std::size_t k) {
+        if (slot_[k] >= 0) slot_[k] = resting(slot_[k]);
+    }
 
     // Hot-loop access for the force kernel: the slot of each entry, and the
     // records: slot s holds the shear at record(s) and, if keepsRolling(), the
     // rolling torque right after it (one cache line per contact, not two).
     int* slots() { return slot_.data(); }
+    int slot(std::size_t k) const { return slot_[k]; }
     double* record(int s) { return data_.data() + static_cast<std::size_t>(s) * stride(); }
     std::size_t stride() const { return rolling_ ? 6 : 3; }
 
-    // What one thread of a force loop changed: slots of contacts that opened
-    // (already set to -1 in slots()) and histories of new contacts.
+    // What one thread of a force loop changed: the histories of new contacts
+    // (entries without a slot, resting or not).
     struct Changes {
         struct Opened {
             int entry;
             ContactHistory history;
         };
-        std::vector<int> released;
         std::vector<Opened> opened;
-        void clear() {
-            released.clear();
-            opened.clear();
-        }
+        void clear() { opened.clear(); }
     };
     // Applies the changes of all threads, in thread order.
     void commit(const std::vector<Changes>& changes);
 
-    std::size_t slotsInUse() const { return slotCount() - free_.size(); }
+    // Entries with a (non-zero) history, and records held (those and the resting ones).
+    std::size_t contactsWithHistory() const;
+    std::size_t records() const { return slotCount(); }
     std::size_t bytes() const;
 
 private:
@@ -89,9 +102,9 @@ private:
     std::size_t slotCount() const { return data_.size() / stride(); }
 
     bool rolling_ = true;
-    std::vector<int> slot_;  // per list entry
+    std::vector<int> slot_;  // per list entry: record, -1 none, or resting (see above)
     std::vector<double> data_;  // stride() doubles per slot
-    std::vector<int> free_;  // returned slots, reused last-in first-out
+    std::vector<int> map_;  // repack's work array, kept for its memory
 };
 
 }  // namespace dem
