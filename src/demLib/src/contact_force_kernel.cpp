@@ -278,6 +278,19 @@ private:
         return settings_.capillaryForceScale * capillaryForceOfFit(cached.fit, gap);
     }
 
+    // rowsFromLastToFirst: both pair loops walk the list from its last entry to
+    // its first (the rows, and the pairs of each row, backwards).  The list
+    // holds each pair once, as (i, j > i), and the particles are sorted by
+    // cell; so, walking backwards, a row's partners were rows a moment ago and
+    // their data is still in cache, and the only particle data new to the step
+    // is the row's own, which arrives in one sequential stream that the
+    // prefetcher follows.  The per-pair arrays (neighbours, history slots and
+    // records, bridge volumes and fits) are read as descending streams too,
+    // not as short runs that jump back at each row.  Walking forwards, the
+    // partners ahead were where a particle's data was first touched in the
+    // step: scattered misses that go to memory once the bed outgrows the
+    // last-level cache (performance.md, round 9).
+
     // The scalar pair loop (settings_.vectorizedPairLaw = false): one contact
     // after the other through ContactLaw::evaluate; the reference of pairForcesBatched.
     void pairForces(ParticleStore& p, ParticleParticleNeighborList& pairs,
@@ -288,12 +301,13 @@ private:
         constexpr bool keepsRolling = Rolling == RollingModel::EPSD || Rolling == RollingModel::EPSD2;
         const auto [offsets, neighbors, slot, records, stride, bridge] = arraysOf(pairs);
         std::size_t touchingPairs = 0;  // a register, not a store per contact
-        for (int i = begin; i < end; ++i) {
+        // List entries from last to first (see rowsFromLastToFirst).
+        for (int i = end - 1; i >= begin; --i) {
             const Vec3 xi = p.position[i];
             const double ri = p.radius[i];
             Vec3 fi = Vec3::Zero();
             Vec3 ti = Vec3::Zero();
-            for (int k = offsets[i]; k < offsets[i + 1]; ++k) {
+            for (int k = offsets[i + 1] - 1; k >= offsets[i]; --k) {
                 const int j = neighbors[k];
                 const Vec3 d = xi - p.position[j];
                 const double rj = p.radius[j];
@@ -375,8 +389,8 @@ private:
     // forget their springs; bridges are updated as in pairForces) gathers the
     // pairs' inputs into a ContactBatch; evaluateContactBatch runs
     // the law over the batch in vector lanes; the forces and torques are added
-    // in list order.  A row may span batches (its sums are carried over).  The
-    // results are bitwise those of pairForces (same operations, same sums).
+    // in the loop's order.  A row may span batches (its sums are carried over).
+    // The results are bitwise those of pairForces (same operations, same sums).
     void pairForcesBatched(ParticleStore& p, ParticleParticleNeighborList& pairs,
                            const InteractionTable& interactions, double dt, ForceSink& sink,
                            ContactStatistics& stats, ContactHistoryPool::Changes& changes, ContactBatch& b,
@@ -387,22 +401,24 @@ private:
         constexpr int capacity = ContactBatch::capacity;
         const auto [offsets, neighbors, slot, records, stride, bridge] = arraysOf(pairs);
         std::size_t touchingPairs = 0;
-        int row = begin;                      // pass 1's cursor: row and list entry
-        int k = begin < end ? offsets[begin] : 0;
-        int sumRow = begin;                   // pass 3's cursor and the sums of its row
+        // List entries from last to first (see rowsFromLastToFirst): k runs down
+        // through the rows.
+        int row = end - 1;                    // pass 1's cursor: row and list entry
+        int k = begin < end ? offsets[end] - 1 : 0;
+        int sumRow = end - 1;                 // pass 3's cursor and the sums of its row
         Vec3 fi = Vec3::Zero();
         Vec3 ti = Vec3::Zero();
-        while (row < end) {
-            // Pass 1a: the touching test over the listed pairs, in list order.
+        while (row >= begin) {
+            // Pass 1a: the touching test over the listed pairs.
             // Without cohesion it selects without a branch: every pair is
             // written at the next free entry and the count grows by one if it
             // touches (the test is a coin toss for the branch predictor).
             int count = 0;
-            for (; row < end; ++row) {
+            for (; row >= begin; --row) {
                 const Vec3 xi = p.position[row];
                 const double ri = p.radius[row];
-                const int rowEnd = offsets[row + 1];
-                for (; k < rowEnd && count < capacity; ++k) {
+                const int rowStart = offsets[row];
+                for (; k >= rowStart && count < capacity; --k) {
                     const int j = neighbors[k];
                     const Vec3 d = xi - p.position[j];
                     const double rj = p.radius[j];
@@ -447,8 +463,7 @@ private:
                     b.radiusI[e] = ri;
                     b.radiusJ[e] = rj;
                 }
-                if (k < rowEnd) break;  // batch full inside this row
-                if (row + 1 < end) k = offsets[row + 1];
+                if (k >= rowStart) break;  // batch full inside this row
             }
             if constexpr (Cohesion == CohesionModel::None) touchingPairs += count;
 
@@ -488,16 +503,16 @@ private:
             // Pass 2: the law in vector lanes.
             if (count > 0) evaluateContactBatch<Rolling, Cohesion == CohesionModel::Capillary>(b, count, dt);
 
-            // Pass 3: sums in list order; every row before pass 1's cursor is complete.
+            // Pass 3: sums in the loop's order; every row after pass 1's cursor is complete.
             auto closeRow = [&]() {
                 sink.force[sumRow] += fi;
                 sink.torque[sumRow] += ti;
                 fi.setZero();
                 ti.setZero();
-                ++sumRow;
+                --sumRow;
             };
             for (int e = 0; e < count; ++e) {
-                while (sumRow < b.particleI[e]) closeRow();
+                while (sumRow > b.particleI[e]) closeRow();
                 const int j = b.particleJ[e];
                 const Vec3 f(b.fx[e], b.fy[e], b.fz[e]);
                 fi += f;
@@ -526,7 +541,7 @@ private:
                     changes.opened.push_back({b.entry[e], history});
                 }
             }
-            while (sumRow < row) closeRow();
+            while (sumRow > row) closeRow();
         }
         stats.touchingPairs += touchingPairs;
     }
