@@ -146,6 +146,8 @@ TEST(PairStateMemory, ContactThatOpensForgetsItsHistoryAndTakesItsRecordBackWhen
         ASSERT_EQ(pool.contactsWithHistory(), 1u);
         const int record = pool.slot(0);
         ASSERT_GE(record, 0);
+        const double shearBefore = sim.pairList().state()[0].contact.shear.norm();  // 5 steps' worth
+        ASSERT_GT(shearBefore, 0.0);
         sim.particles().velocity[0] = Vec3(-0.05, 0, 0);  // 0 leaves 1: 1 um in 20 us
         sim.step(100);
         EXPECT_EQ(sim.lastStep().contacts.touchingPairs, 0u);
@@ -159,6 +161,8 @@ TEST(PairStateMemory, ContactThatOpensForgetsItsHistoryAndTakesItsRecordBackWhen
         sim.particles().velocity[0] = Vec3(0.05, 0.01, 0);
         for (int n = 0; n < 300 && sim.lastStep().contacts.touchingPairs == 0; ++n) sim.step(1);
         ASSERT_EQ(sim.lastStep().contacts.touchingPairs, 1u);
+        // One step's worth of spring, not the resting record's old value.
+        EXPECT_LT(sim.pairList().state()[0].contact.shear.norm(), 0.5 * shearBefore);
         sim.step(5);
         EXPECT_EQ(sim.pairList().buildCount(), 1);
         EXPECT_EQ(pool.slot(0), record);

@@ -236,14 +236,12 @@ private:
     // A contact that opens forgets its springs (LIGGGHTS surfacesClose): its
     // record rests until the next list build, and the pair takes it back if it
     // touches again (ContactHistoryPool).
-    static DEM_ALWAYS_INLINE void forgetSprings(int* slot, int k) {
-        if (slot[k] >= 0) slot[k] = ContactHistoryPool::resting(slot[k]);
-    }
-    // The record of a contact that touches again after resting, or null (a new
-    // contact: its history goes to the pool's new records after the loop).
+    static DEM_ALWAYS_INLINE void forgetSprings(int* slot, int k) { ContactHistoryPool::rest(slot[k]); }
+    // The record the history of a touching contact goes to (a resting one is
+    // taken back), or null (a new contact: its history goes to the pool's new
+    // records after the loop).
     static DEM_ALWAYS_INLINE double* recordToWrite(int* slot, int k, double* records, std::size_t stride) {
-        int s = slot[k];
-        if (ContactHistoryPool::isResting(s)) slot[k] = s = ContactHistoryPool::restingRecord(s);
+        const int s = ContactHistoryPool::wake(slot[k]);
         return s >= 0 ? records + s * stride : nullptr;
     }
 
@@ -367,7 +365,7 @@ private:
                 }
                 const ContactForces f =
                     Law::evaluate(kin, interactions(p.material[i], p.material[j]), history, cohesiveForce);
-                if (double* out = record ? record : recordToWrite(slot, k, records, stride)) {
+                if (double* out = recordToWrite(slot, k, records, stride)) {
                     Vec3::Map(out) = history.shear;
                     if constexpr (keepsRolling) Vec3::Map(out + 3) = history.rollingTorque;
                 } else {

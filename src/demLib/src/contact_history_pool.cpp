@@ -112,10 +112,7 @@ int ContactHistoryPool::takeSlot() {
 }
 
 void ContactHistoryPool::set(std::size_t k, const ContactHistory& h) {
-    if (isResting(slot_[k]))
-        slot_[k] = restingRecord(slot_[k]);
-    else if (slot_[k] < 0)
-        slot_[k] = takeSlot();
+    if (wake(slot_[k]) < 0) slot_[k] = takeSlot();
     double* r = record(slot_[k]);
     Vec3::Map(r) = h.shear;
     if (rolling_) Vec3::Map(r + 3) = h.rollingTorque;

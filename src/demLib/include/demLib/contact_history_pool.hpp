@@ -49,6 +49,16 @@ public:
     static constexpr bool isResting(int slot) { return slot <= -3; }
     static constexpr int resting(int record) { return -3 - record; }
     static constexpr int restingRecord(int slot) { return -3 - slot; }
+    // One entry's slot, in the pool or in the force kernel's raw slot array:
+    // the contact opened (its record rests), or touches again (a resting
+    // record is taken back; returns the record, or -1 for none).
+    static void rest(int& slot) {
+        if (slot >= 0) slot = resting(slot);
+    }
+    static int wake(int& slot) {
+        if (isResting(slot)) slot = restingRecord(slot);
+        return slot;
+    }
     // Hands out the slot array (the pool then has no entries), e.g. to reuse
     // its memory once the slots were copied elsewhere.
     std::vector<int> releaseSlots() { return std::move(slot_); }
@@ -67,9 +77,7 @@ public:
     // slot is taken if it has none).
     void set(std::size_t k, const ContactHistory& h);
     // Entry k's contact opened: its history is zero from now on (its record rests).
-    void open(std::size_t k) {
-        if (slot_[k] >= 0) slot_[k] = resting(slot_[k]);
-    }
+    void open(std::size_t k) { rest(slot_[k]); }
 
     // Hot-loop access for the force kernel: the slot of each entry, and the
     // records: slot s holds the shear at record(s) and, if keepsRolling(), the
