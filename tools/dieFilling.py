@@ -178,6 +178,39 @@ def die_geometry(d):
     return radius, z1 - z0, z0, opening
 
 
+def wall_load_results(s, props, until, mass_in_system, mass_in_die, out):
+    """What the walls carry (the wallForce_<wall>_z columns of summary.csv, force of the
+    particles on each wall): the loads in grams-force against time (wallLoads.png), and
+    just before time `until` the share of the weight of all particles the walls carry together
+    (1 at rest without air) and the share of the die's powder weight on the die base
+    (below 1: the die wall holds the rest by friction, Janssen)."""
+    names = [k[len("wallForce_"):-2] for k in s if k.startswith("wallForce_") and k.endswith("_z")]
+    if not names:
+        return {}
+    g = abs(float(np.asarray(props.get("simulation", {}).get("gravity", (0, 0, -9.81)), float)[2]))
+    t = s["time"]
+    loads = {w: -np.asarray(s["wallForce_%s_z" % w]) / g for w in names}       # kg
+    plots.curve(os.path.join(out, "wallLoads.png"), t, [loads[w] * 1e3 for w in names] + [s["mass_die"] * 1e3],
+                ["load on %s" % w for w in names] + ["mass in the die"], "time [s]", "[g]",
+                title="weight carried by the walls (force of the particles / g)",
+                vlines=[(until, "die opening starts")])
+    # The last line before `until`: at the opening's start the die wall begins to slide
+    # along the bed and the loads swing for a moment.
+    k = int(np.searchsorted(t, until - 1e-9)) - 1 if until < t[-1] else len(t) - 1
+    if k < 0:
+        return {}
+    res = {"wallLoadFilled": {"value": round(sum(float(loads[w][k]) for w in names) / mass_in_system, 4),
+                              "unit": "-", "description": "weight carried by all walls together over the "
+                                                          "weight of the particles at t = %g s (1 at rest "
+                                                          "without air)" % t[k]}}
+    if "dieBase" in loads and mass_in_die > 0:
+        res["dieBaseLoadFilled"] = {"value": round(float(loads["dieBase"][k]) / mass_in_die, 4), "unit": "-",
+                                    "description": "weight carried by the die base over the weight of the "
+                                                   "powder in the die at t = %g s (below 1: the die wall "
+                                                   "holds the rest by friction)" % t[k]}
+    return res
+
+
 def common_results(t50, t90, mean_fill_pass, shoe_pass, with_air, wet, pass_note):
     """The entries of results.json that a finished run and one in progress share."""
     return {
@@ -225,6 +258,8 @@ def report_before_opening(case, out, props, s, frames, poured, fill, opening, en
                               with_air, wet, "the part simulated so far"))
     if with_air:
         res.update(case_air_results(case, props, min(opening, float(t[-1])), out, s)[0])
+    res.update(wall_load_results(s, props, float(t[-1]), poured - float(s["lostMass"][-1]),
+                                 float(s["mass_die"][-1]), out))
     if run_time is not None:
         res["runTime"] = {"value": run_time, "unit": "s", "description": "wall time of the run"}
     results.write(case, res)
@@ -354,6 +389,7 @@ def main():
         res["runTime"] = {"value": a.runTime, "unit": "s", "description": "wall time of demRun"}
     res["simulatedTime"] = {"value": float(t[-1]), "unit": "s",
                             "description": "last time in dem/summary.csv (the case ends at %g s)" % end_time}
+    res.update(wall_load_results(s, props, opening, poured - lost_before_opening, mass_die_filled, out))
     if in_progress:
         print("dieFilling.py: the run is not finished (t = %g s of %g s): the figures below are those "
               "of that time, not the final ones" % (t[-1], end_time))
@@ -364,6 +400,9 @@ def main():
              f"{right['angle']:.1f}" if right else "n/a", mass_die_filled / poured,
              100 * lost_at_opening / max(mass_die_filled, 1e-30),
              f"{t50:.3f}" if t50 is not None else "n/a", f"{t90:.3f}" if t90 is not None else "n/a"))
+    if "dieBaseLoadFilled" in res:
+        print("    walls at t = %g s: together %.3f of the particles' weight; the die base %.3f of the die's "
+              "powder (wallLoads.png)" % (opening, res["wallLoadFilled"]["value"], res["dieBaseLoadFilled"]["value"]))
     if "aerationOverpressure" in res:
         print("    aeration: %.2f Pa over the air's own pressure on the plate under the shoe's bed "
               "(bed weight per area %.1f Pa)" % (res["aerationOverpressure"]["value"],

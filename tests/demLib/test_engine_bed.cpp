@@ -257,6 +257,30 @@ TEST(EngineBed, PouredBedSettlesInsideTheBoxWithSoundPacking) {
     EXPECT_LT(phiCore, 0.64);
     EXPECT_LT(phiBulk, phiCore);  // walls loosen the packing next to them
     EXPECT_NEAR(surface / predicted, 1.0, 0.03);
+
+    // At rest the walls carry the bed: the forces of the particles on the
+    // walls add up to the bed's weight, straight down.  The floor carries
+    // most of it; the frictional side walls hold friction locked in as the
+    // bed landed and sprang back (here about 7 % of the weight, pulling the
+    // bed down), the lid nothing.
+    double weight = 0.0;
+    for (std::size_t i = 0; i < p.size(); ++i) weight += p.mass[i] * 9.81;
+    const std::vector<Vec3> onWalls = sim.wallForces();
+    ASSERT_EQ(onWalls.size(), sim.walls().size());
+    Vec3 total = Vec3::Zero();
+    for (const Vec3& f : onWalls) total += f;
+    const double floorShare = -onWalls[0].z() / weight, lidShare = onWalls[1].norm() / weight;
+    std::printf("bed: forces on the walls: total (%.4e %.4e %.4e) N, weight %.4e N; floor carries %.4f, "
+                "side walls %.4f, lid %.1e of it; xMin/xMax push %.3e / %.3e N\n",
+                total.x(), total.y(), total.z(), weight, floorShare, 1.0 - floorShare, lidShare,
+                onWalls[2].x(), onWalls[3].x());
+    EXPECT_NEAR(total.z() / weight, -1.0, 2e-3);
+    EXPECT_LT(std::hypot(total.x(), total.y()) / weight, 2e-3);
+    EXPECT_GT(floorShare, 0.8);
+    EXPECT_LT(floorShare, 1.2);
+    EXPECT_EQ(lidShare, 0.0);
+    EXPECT_LT(onWalls[2].x(), -1e-3 * weight);  // the bed pushes the side walls outwards
+    EXPECT_GT(onWalls[3].x(), 1e-3 * weight);
 }
 
 // ---------------------------------------------------------------------------
@@ -317,6 +341,10 @@ void checkRepeatAndRestart(int threadCount) {
                 threadCount, first.lastStep().contacts.touchingPairs, first.lastStep().contacts.wallContacts,
                 rollingHistory);
     first.writeRestart(path);
+    const std::vector<Vec3> wallForcesAtRestart = first.wallForces();
+    // The floor slides in +x under the heap: its friction drags the particles
+    // along, and they hold the floor back.
+    EXPECT_LT(wallForcesAtRestart[0].x(), -1e-3 * std::abs(wallForcesAtRestart[0].z()));
     first.step(kStepsAfter);
 
     // Same thread count, same input: the same bits.
@@ -327,6 +355,9 @@ void checkRepeatAndRestart(int threadCount) {
     dem::Simulation continued(settingsFor(c), first.materials(), first.interactions(), first.walls());
     continued.readRestart(path);
     EXPECT_EQ(continued.stepCount(), kStepsBefore);
+    const std::vector<Vec3> wallForcesRead = continued.wallForces();
+    for (std::size_t w = 0; w < wallForcesRead.size(); ++w)
+        EXPECT_EQ(wallForcesRead[w], wallForcesAtRestart[w]) << "wall " << w << " force after readRestart";
     continued.step(kStepsAfter);
     EXPECT_EQ(continued.stepCount(), first.stepCount());
     EXPECT_EQ(continued.time(), first.time());

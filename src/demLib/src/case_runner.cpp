@@ -160,6 +160,9 @@ void CaseRunner::writeSummaryHeader() {
     if (setup_.waterContent > 0.0)
         summary_ << ",liquidTotal,liquidInBridges,liquidPool,liquidRelativeError,bridges,liquidCoordinationNumber";
     for (const MonitorRegion& r : setup_.output.regions) summary_ << ",mass_" << r.name;
+    // Force of the particles on each wall [N] (contacts and liquid bridges).
+    for (const Wall& w : simulation_->walls())
+        for (const char* axis : {"x", "y", "z"}) summary_ << ",wallForce_" << w.name << "_" << axis;
     summary_ << "\n";
 }
 
@@ -177,6 +180,7 @@ void CaseRunner::writeSummaryLine() {
                  << l.bridgeCount << "," << s.liquidCoordinationNumber();
     }
     for (const MonitorRegion& r : setup_.output.regions) summary_ << "," << massInRegion(p, *r.region);
+    for (const Vec3& f : s.wallForces()) summary_ << "," << f.x() << "," << f.y() << "," << f.z();
     summary_ << "\n";
     summary_.flush();
     lastLogStep_ = s.stepCount();

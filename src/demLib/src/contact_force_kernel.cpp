@@ -579,7 +579,8 @@ private:
                 if (!touching) {
                     // Within the bridge reach only: no contact history, the
                     // bridge pulls along the wall normal through the centre.
-                    force[i] += cohesiveForce * c.normal;
+                    rec.force = cohesiveForce * c.normal;
+                    force[i] += rec.force;
                     out.push_back(rec);
                     return;
                 }
@@ -599,6 +600,7 @@ private:
                     kin.rollingInertiaEff = rollingInertiaWall(p.mass[i], ri);
                 const ContactForces f = Law::evaluate(kin, interactions(p.material[i], walls[w].materialIndex),
                                                       rec.history, cohesiveForce);
+                rec.force = f.force;
                 force[i] += f.force;
                 torque[i] += -ci * c.normal.cross(f.tangentialForce) + f.rollingTorque;
                 out.push_back(rec);

@@ -204,6 +204,12 @@ double Simulation::coordinationNumber() const {
     return n == 0 ? 0.0 : 2.0 * static_cast<double>(last_.contacts.touchingPairs) / n;
 }
 
+std::vector<Vec3> Simulation::wallForces() const {
+    std::vector<Vec3> sum(walls_.size(), Vec3::Zero());
+    for (const WallContactRecord& r : wallContacts_.records()) sum[r.wall] -= r.force;
+    return sum;
+}
+
 void Simulation::removeLostParticles(bool knownNoneLost) {
     last_.lostThisStep = 0;
     if (!settings_.domain || knownNoneLost) return;

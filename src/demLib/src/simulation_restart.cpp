@@ -85,7 +85,7 @@ void Simulation::writeRestart(const std::string& path) const {
         f.write("pairs/bridgeVolume", bridge);
 
         std::vector<std::int64_t> wallKeys;
-        std::vector<Vec3> wShear, wRolling;
+        std::vector<Vec3> wShear, wRolling, wForce;
         std::vector<double> wBridge;
         for (const WallContactRecord& r : wallContacts_.records()) {
             wallKeys.push_back(p.id[r.particle]);
@@ -94,12 +94,14 @@ void Simulation::writeRestart(const std::string& path) const {
             wShear.push_back(r.history.shear);
             wRolling.push_back(r.history.rollingTorque);
             wBridge.push_back(r.bridgeVolume);
+            wForce.push_back(r.force);
         }
         f.createGroup("wallContacts");
         f.write("wallContacts/keys", wallKeys, 3);
         f.write("wallContacts/shear", wShear);
         f.write("wallContacts/rollingTorque", wRolling);
         f.write("wallContacts/bridgeVolume", wBridge);
+        f.write("wallContacts/force", wForce);
     }
     if (std::rename(tmp.c_str(), path.c_str()) != 0)
         throw RuntimeError("cannot rename restart file '" + tmp + "' to '" + path + "'");
@@ -208,6 +210,8 @@ void Simulation::readRestart(const std::string& path) {
     const auto wShear = f.readVec3("wallContacts/shear");
     const auto wRolling = f.readVec3("wallContacts/rollingTorque");
     const auto wBridge = f.readDoubles("wallContacts/bridgeVolume");
+    // Files from before the wall forces were kept: zero until the next step.
+    const auto wForce = f.exists("wallContacts/force") ? f.readVec3("wallContacts/force") : std::vector<Vec3>();
     for (std::size_t k = 0; k < wShear.size(); ++k) {
         WallContactRecord r;
         r.particle = lookup(keys[3 * k]);
@@ -216,6 +220,7 @@ void Simulation::readRestart(const std::string& path) {
         r.history.shear = wShear[k];
         r.history.rollingTorque = wRolling[k];
         r.bridgeVolume = wBridge[k];
+        if (k < wForce.size()) r.force = wForce[k];
         // A run continued without wall bridges: their liquid waits in the pool.
         if (!settings_.forces.wallBridges) {
             liquid_.poolVolume += r.bridgeVolume;

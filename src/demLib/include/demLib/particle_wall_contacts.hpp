@@ -23,6 +23,9 @@ struct WallContactRecord {
     int feature = 0;
     ContactHistory history;
     double bridgeVolume = 0.0;  // liquid held by a particle-wall bridge (0: none)
+    // Force of the wall on the particle in the last step (contact and bridge);
+    // the particle pushes the wall with -force (Simulation::wallForces).
+    Vec3 force = Vec3::Zero();
 
     bool sameKey(const WallContactRecord& o) const {
         return particle == o.particle && wall == o.wall && feature == o.feature;

@@ -134,6 +134,10 @@ public:
     double liquidCoordinationNumber() const;
     // Mean number of touching contacts per particle.
     double coordinationNumber() const;
+    // Force of the particles on each wall in the last step (contacts and
+    // liquid bridges; walls in the order of walls()) [N].  With a
+    // decomposition: of this rank's particles.
+    std::vector<Vec3> wallForces() const;
 
     // Largest time step the settings accept for the particles present, and the
     // two limits it is the smaller of.
