@@ -102,7 +102,11 @@ int main(int argc, char *argv[])
         if (coupling.modelA())
         {
             alphaP = alpha;
-            alphaPf = alphaf;
+            // Linear (scheme interpolate(alphaP)), not alphaf's scheme: the
+            // air then takes alphaPf of each face's pressure force and the
+            // particles, through the Gauss gradient, the rest
+            // (docs/coupling.md, "Air equations").
+            alphaPf = fvc::interpolate(alphaP);
         }
         coupling.updateExchange(Ksp, KUp);
 

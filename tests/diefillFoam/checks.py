@@ -249,29 +249,43 @@ def fluidisation(args):
     inertia = abs(v_at(t1) - v_at(t0)) / (g * (t1 - t0))
     print(f"    quasi-steady: mean bed acceleration over the plateau window {inertia:.2e} g "
           f"(tolerance 1e-2)")
-    if part == "support":
-        return bed_support(case, log, steps, t0, t1, n * volume * rho_p * g, n * volume * rho * g,
-                           plateau * area)
+    fluid, per_wall = bed_support(case, log, steps, t0, t1)
+    support = sum(per_wall.values())
+    weight_n = n * volume * rho_p * g
+    buoyancy = n * volume * rho * g
+    closure = (fluid + support) / weight_n - 1
+    exchange = (plateau * area - (fluid - buoyancy)) / weight_n
+    expected = (weight * area - support) / (weight * area)
+    err_supported = (plateau * area - (weight * area - support)) / (weight * area)
+    print(f"    plateau window {t0:.4f}-{t1:.4f} s, in units of the beads' weight: fluid force {fluid / weight_n:.4f}, "
+          "walls' support " + ", ".join(f"{w} {f / weight_n + 0.0:.4f}" for w, f in per_wall.items()))
+    print(f"    beads: fluid force + support - weight = {closure:+.2e} (tolerance 1e-2); air: pressure drop x area "
+          f"- (fluid force on the beads - buoyancy) = {exchange:+.2e} of the weight (tolerance 1e-2)")
+    print(f"    plateau vs buoyant weight less the walls' support ({expected:.4f} of it): {100 * err_supported:+.2f} % "
+          f"(tolerance 2 %)")
     with open(f"{case}/fluidisation.figures", "w") as out:
         out.write(f"plateau {plateau:.10g}\numf {u_mf:.10g}\n")
     if part == "plateau":
-        # 3 %: the plateau sits systematically below the weight (-1.5 to -2.5 %
-        # in runs that differ only in rounding; quarters of the window -0.7 to
-        # -2.9 %).  Measured (`support`): the bottom layer still rests on the
-        # distributor, which carries about 6 % of the weight over the window,
-        # while the pressure drop exceeds the fluid force on the particles by
-        # 3-5 % of the weight (the pressure-gradient force in the cells at the
-        # bed's ends, docs/coupling.md); a drag not returned to the air or a
+        # The bed's bottom layer still rests on the distributor at 1.5 u_mf
+        # (about 6 % of the weight, measured with demLib's wall forces): the
+        # plateau is the buoyant weight less that support (2 %), and within
+        # 10 % of the buoyant weight.  A drag not returned to the air or a
         # doubled pressure-gradient force misses by tens of per cent.
-        return abs(err_plateau) < 0.03 and inertia < 1e-2
+        return abs(err_supported) < 0.02 and abs(err_plateau) < 0.10 and inertia < 1e-2
+    if part == "support":
+        # Momentum: the beads' balance closes with the walls' support, and the
+        # air loses to the beads what the pressure drop gives it (a face void
+        # fraction of the pressure force other than the particles' complement,
+        # e.g. localMin, missed by 4.6 %; docs/coupling.md).
+        return abs(closure) < 1e-2 and abs(exchange) < 1e-2
     return abs(err_umf) < 0.10 and abs(err_fixed) < 0.10
 
 
-def bed_support(case, log, steps, t0, t1, weight, buoyancy, dp_force):
-    """The particles' force balance over the plateau window: the fluid force
-    on them (drag + other forces of the log) plus the support of the walls
-    (minus the walls' wallForce_*_z of dem/summary.csv) equals their weight
-    within 1 %.  Prints what carries the bed."""
+def bed_support(case, log, steps, t0, t1):
+    """Over the window [t0, t1]: the mean fluid force on the beads (drag + other
+    forces of the coupling lines of the log) and the mean support of each wall
+    (minus its wallForce_<wall>_z of dem/summary.csv, demLib's force of the
+    particles on the wall), in N."""
     drag = [float(v.split()[2]) for v in re.findall(r"drag on particles " + VEC, log)][1:]
     other = [float(v.split()[2]) for v in re.findall(r"other fluid forces on particles " + VEC, log)][1:]
     window = [k for k, t in enumerate(steps) if t0 <= t <= t1 and k < len(drag)]
@@ -281,15 +295,9 @@ def bed_support(case, log, steps, t0, t1, weight, buoyancy, dp_force):
     columns = [i for i, name in enumerate(head) if name.startswith("wallForce_") and name.endswith("_z")]
     rows = [[float(x) for x in line.split(",")] for line in lines[1:]]
     rows = [r for r in rows if t0 <= r[0] <= t1]
-    per_wall = {head[i][len("wallForce_"):-2]: -sum(r[i] for r in rows) / len(rows) for i in columns}
-    support = sum(per_wall.values())
-    closure = (fluid + support) / weight - 1
-    print(f"    plateau window {t0:.4f}-{t1:.4f} s ({len(window)} coupling steps, {len(rows)} DEM log lines), "
-          f"in units of the beads' weight: fluid force {fluid / weight:.4f}, walls "
-          + ", ".join(f"{w} {f / weight + 0.0:.4f}" for w, f in per_wall.items())
-          + f"; sum - 1 = {closure:+.2e} (tolerance 1e-2); pressure drop x area {dp_force / weight:.4f} "
-          f"(fluid force less buoyancy {(fluid - buoyancy) / weight:.4f})")
-    return len(rows) >= 5 and len(columns) > 0 and abs(closure) < 1e-2
+    if not columns or len(rows) < 5:
+        raise SystemExit(f"checks.py: {case}/dem/summary.csv has no wall forces over the plateau window")
+    return fluid, {head[i][len("wallForce_"):-2]: -sum(r[i] for r in rows) / len(rows) for i in columns}
 
 
 def numbers_of(path):
