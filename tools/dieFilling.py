@@ -178,10 +178,10 @@ def die_geometry(d):
     return radius, z1 - z0, z0, opening
 
 
-def wall_load_results(s, props, until, mass_in_system, mass_in_die, out):
+def wall_load_results(s, props, until, mass_in_system, mass_in_die, out, shoe_end=None):
     """What the walls carry (the wallForce_<wall>_z columns of summary.csv, force of the
     particles on each wall): the loads in grams-force against time (wallLoads.png), and
-    just before time `until` the share of the weight of all particles the walls carry together
+    before time `until` (a mean, see below) the share of the weight of all particles the walls carry together
     (1 at rest without air) and the share of the die's powder weight on the die base
     (below 1: the die wall holds the rest by friction, Janssen)."""
     names = [k[len("wallForce_"):-2] for k in s if k.startswith("wallForce_") and k.endswith("_z")]
@@ -194,20 +194,24 @@ def wall_load_results(s, props, until, mass_in_system, mass_in_die, out):
                 ["load on %s" % w for w in names] + ["mass in the die"], "time [s]", "[g]",
                 title="weight carried by the walls (force of the particles / g)",
                 vlines=[(until, "die opening starts")])
-    # The last line before `until`: at the opening's start the die wall begins to slide
-    # along the bed and the loads swing for a moment.
-    k = int(np.searchsorted(t, until - 1e-9)) - 1 if until < t[-1] else len(t) - 1
-    if k < 0:
+    # Averaged over the lines between the shoe's pass (if it ended before) and `until`, at
+    # most 0.5 s: a wet bed standing on a few contacts rattles, and at the opening's start the
+    # die wall begins to slide along the bed.
+    start = max(until - 0.5, shoe_end if shoe_end is not None and shoe_end < until else until - 0.1)
+    window = (t >= start - 1e-9) & (t < until - 1e-9) if until < t[-1] else (t >= start - 1e-9)
+    if not window.any():
         return {}
-    res = {"wallLoadFilled": {"value": round(sum(float(loads[w][k]) for w in names) / mass_in_system, 4),
-                              "unit": "-", "description": "weight carried by all walls together over the "
-                                                          "weight of the particles at t = %g s (1 at rest "
-                                                          "without air)" % t[k]}}
+    k = np.flatnonzero(window)
+    span = "mean over t = %.3g-%.3g s (%d lines)" % (t[k[0]], t[k[-1]], len(k))
+    res = {"wallLoadFilled": {"value": round(sum(float(np.mean(loads[w][k])) for w in names) / mass_in_system, 4),
+                              "unit": "-", "description": "weight carried by all walls together over the weight "
+                                                          "of the particles, %s (1 at rest without air)" % span}}
     if "dieBase" in loads and mass_in_die > 0:
-        res["dieBaseLoadFilled"] = {"value": round(float(loads["dieBase"][k]) / mass_in_die, 4), "unit": "-",
+        res["dieBaseLoadFilled"] = {"value": round(float(np.mean(loads["dieBase"][k])) / mass_in_die, 4),
+                                    "unit": "-",
                                     "description": "weight carried by the die base over the weight of the "
-                                                   "powder in the die at t = %g s (below 1: the die wall "
-                                                   "holds the rest by friction)" % t[k]}
+                                                   "powder in the die, %s (below 1: the die wall holds the "
+                                                   "rest by friction)" % span}
     return res
 
 
@@ -259,7 +263,7 @@ def report_before_opening(case, out, props, s, frames, poured, fill, opening, en
     if with_air:
         res.update(case_air_results(case, props, min(opening, float(t[-1])), out, s)[0])
     res.update(wall_load_results(s, props, float(t[-1]), poured - float(s["lostMass"][-1]),
-                                 float(s["mass_die"][-1]), out))
+                                 float(s["mass_die"][-1]), out, shoe_pass[1] if shoe_pass else None))
     if run_time is not None:
         res["runTime"] = {"value": run_time, "unit": "s", "description": "wall time of the run"}
     results.write(case, res)
@@ -389,7 +393,8 @@ def main():
         res["runTime"] = {"value": a.runTime, "unit": "s", "description": "wall time of demRun"}
     res["simulatedTime"] = {"value": float(t[-1]), "unit": "s",
                             "description": "last time in dem/summary.csv (the case ends at %g s)" % end_time}
-    res.update(wall_load_results(s, props, opening, poured - lost_before_opening, mass_die_filled, out))
+    res.update(wall_load_results(s, props, opening, poured - lost_before_opening, mass_die_filled, out,
+                                 shoe_pass[1] if shoe_pass else None))
     if in_progress:
         print("dieFilling.py: the run is not finished (t = %g s of %g s): the figures below are those "
               "of that time, not the final ones" % (t[-1], end_time))
@@ -401,8 +406,8 @@ def main():
              100 * lost_at_opening / max(mass_die_filled, 1e-30),
              f"{t50:.3f}" if t50 is not None else "n/a", f"{t90:.3f}" if t90 is not None else "n/a"))
     if "dieBaseLoadFilled" in res:
-        print("    walls at t = %g s: together %.3f of the particles' weight; the die base %.3f of the die's "
-              "powder (wallLoads.png)" % (opening, res["wallLoadFilled"]["value"], res["dieBaseLoadFilled"]["value"]))
+        print("    walls before the opening: together %.3f of the particles' weight; the die base %.3f of the die's "
+              "powder (wallLoads.png)" % (res["wallLoadFilled"]["value"], res["dieBaseLoadFilled"]["value"]))
     if "aerationOverpressure" in res:
         print("    aeration: %.2f Pa over the air's own pressure on the plate under the shoe's bed "
               "(bed weight per area %.1f Pa)" % (res["aerationOverpressure"]["value"],
