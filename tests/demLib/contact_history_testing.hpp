@@ -10,13 +10,13 @@ namespace dem_testing {
 inline dem::ContactHistory history(double s, double r) {
     dem::ContactHistory h;
     h.shear = dem::Vec3(s, 2 * s, 3 * s);
-    h.rollingTorque = dem::Vec3(r, -r, 0.5 * r);
+    h.rollingAngle = dem::Vec3(r, -r, 0.5 * r);
     return h;
 }
 
 inline void expectHistory(const dem::ContactHistory& h, const dem::ContactHistory& expected) {
     EXPECT_EQ(h.shear, expected.shear);
-    EXPECT_EQ(h.rollingTorque, expected.rollingTorque);
+    EXPECT_EQ(h.rollingAngle, expected.rollingAngle);
 }
 
 }  // namespace dem_testing

@@ -89,7 +89,7 @@ struct PairInput {
 struct PairOutput {
     Vec3 force, torqueI, torqueJ, shear, rollingSpring;
     bool sliding = false;         // Coulomb limit reached
-    bool rollingLimited = false;  // EPSD/EPSD2: |M| > mu_r R* |Fn|
+    bool rollingLimited = false;  // EPSD/EPSD2: |kr theta| > mu_r R* |Fn|
     bool resting = false;         // CDT: w_i = w_j (no rolling torque)
 };
 
@@ -124,7 +124,7 @@ PairOutput scalarReference(const PairInput& in, const dem::InteractionTable& tab
         kin.rollingInertiaEff = dem::rollingInertiaEff(in.mi, in.ri, in.mj, in.rj);
     dem::ContactHistory history;
     history.shear = in.history.shear;
-    if constexpr (keepsRolling<Rolling>()) history.rollingTorque = in.history.rollingTorque;
+    if constexpr (keepsRolling<Rolling>()) history.rollingAngle = in.history.rollingAngle;
     const dem::InteractionProperties& props = table(in.materialI, in.materialJ);
     const double cohesiveForce = 0.0;
 
@@ -144,7 +144,9 @@ PairOutput scalarReference(const PairInput& in, const dem::InteractionTable& tab
                                   ? dem::epsdRollingStiffness(h.normalStiffness, props.rollingFriction, kin.radiusEff)
                                   : dem::epsd2RollingStiffness(h.tangentialStiffness, kin.radiusEff);
             const Vec3 wt = kin.relOmega - kin.relOmega.dot(normal) * normal;
-            const Vec3 m = history.rollingTorque - (kr * dt) * wt;
+            Vec3 angle = history.rollingAngle + wt * dt;
+            angle -= angle.dot(normal) * normal;
+            const Vec3 m = -kr * angle;
             const double torqueLimit = props.rollingFriction * kin.radiusEff * std::abs(h.force);
             out.rollingLimited = m.squaredNorm() > torqueLimit * torqueLimit;
         }
@@ -157,7 +159,7 @@ PairOutput scalarReference(const PairInput& in, const dem::InteractionTable& tab
     out.torqueI = -ci * nxFt + f.rollingTorque;
     out.torqueJ = -cj * nxFt - f.rollingTorque;
     out.shear = history.shear;
-    out.rollingSpring = history.rollingTorque;
+    out.rollingSpring = history.rollingAngle;
     return out;
 }
 
@@ -192,9 +194,9 @@ void fillLane(ContactBatch& b, int e, int entry, const PairInput& in, const dem:
     b.sy[e] = in.history.shear.y();
     b.sz[e] = in.history.shear.z();
     if constexpr (keepsRolling<Rolling>()) {
-        b.mx[e] = in.history.rollingTorque.x();
-        b.my[e] = in.history.rollingTorque.y();
-        b.mz[e] = in.history.rollingTorque.z();
+        b.mx[e] = in.history.rollingAngle.x();
+        b.my[e] = in.history.rollingAngle.y();
+        b.mz[e] = in.history.rollingAngle.z();
     }
 }
 
@@ -215,8 +217,10 @@ Vec3 randomInBall(std::mt19937_64& rng, double radius) {
 // Spring histories are scaled by the Coulomb and rolling limits of the pair,
 // estimated from the elastic force: a quarter zero, a quarter well inside,
 // half up to three times the limit (most of these slide or hit the limit).
+// The rolling spring is an angle: its limit is the torque limit over the
+// rolling stiffness of the model (rolling).
 std::vector<PairInput> randomContacts(int count, bool uniform, const dem::InteractionTable& table,
-                                      std::mt19937_64& rng) {
+                                      RollingModel rolling, std::mt19937_64& rng) {
     std::uniform_real_distribution<double> u01(0.0, 1.0);
     const std::vector<dem::Material> mats{sand(), steel()};
     std::vector<PairInput> contacts;
@@ -247,6 +251,11 @@ std::vector<PairInput> randomContacts(int count, bool uniform, const dem::Intera
         const double kt = props.tangentialStiffnessFactor * std::sqrt(radiusEff * overlap);
         const double shearLimit = props.friction * elastic / kt;
         const double torqueLimit = props.rollingFriction * radiusEff * elastic;
+        const double rollingStiffness =
+            rolling == RollingModel::EPSD
+                ? dem::epsdRollingStiffness(props.normalStiffnessFactor * std::sqrt(radiusEff * overlap),
+                                            props.rollingFriction, radiusEff)
+                : dem::epsd2RollingStiffness(kt, radiusEff);
         auto level = [&]() {
             const double r = u01(rng);
             if (r < 0.25) return 0.0;
@@ -255,7 +264,7 @@ std::vector<PairInput> randomContacts(int count, bool uniform, const dem::Intera
         };
         // Not exactly tangential: the law projects the spring onto the plane.
         in.history.shear = level() * shearLimit * (randomUnit(rng) + 0.1 * n).normalized();
-        in.history.rollingTorque = level() * torqueLimit * randomUnit(rng);
+        in.history.rollingAngle = level() * (torqueLimit / rollingStiffness) * randomUnit(rng);
         contacts.push_back(in);
     }
     return contacts;
@@ -289,7 +298,7 @@ LaneComparison compareBatchWithScalar(bool uniform, std::uint64_t seed) {
     const dem::InteractionTable table = sandSteelTable();
     std::mt19937_64 rng(seed);
     const int total = 2000;
-    const std::vector<PairInput> contacts = randomContacts(total, uniform, table, rng);
+    const std::vector<PairInput> contacts = randomContacts(total, uniform, table, Rolling, rng);
     const std::vector<int> sizes = chunkSizes(total, rng);
     const double dt = 1e-6;
 
@@ -511,8 +520,8 @@ int stateDifferences(const dem::Simulation& a, const dem::Simulation& b, std::st
         const dem::PairState x = sa[k], y = sb[k];
         for (int c = 0; c < 3; ++c) {
             note("shear spring of pair entry " + std::to_string(k), x.contact.shear[c], y.contact.shear[c]);
-            note("rolling spring of pair entry " + std::to_string(k), x.contact.rollingTorque[c],
-                 y.contact.rollingTorque[c]);
+            note("rolling spring of pair entry " + std::to_string(k), x.contact.rollingAngle[c],
+                 y.contact.rollingAngle[c]);
         }
     }
     return differences;

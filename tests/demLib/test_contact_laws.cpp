@@ -429,6 +429,8 @@ TEST(RollingCDT, ConstantTorqueOpposesRelativeRotation) {
 }
 
 TEST(RollingEPSD2, SpringTorqueGrowsWithRotationThenSaturates) {
+    // The spring is kept as the rolled angle (tangential part of w dt, summed);
+    // the torque is -kr times it, up to the limit mu_r R* |Fn|.
     const InteractionProperties props = sandSand(0.5, 0.7, 0.5);
     const double radius = 1e-3;
     const double mass = sphereMass(radius, kSand.density);
@@ -447,13 +449,19 @@ TEST(RollingEPSD2, SpringTorqueGrowsWithRotationThenSaturates) {
             ContactLaw<RollingModel::EPSD2>::evaluate(kin, props, history).rollingTorque;
         EXPECT_EQ(torque.x(), 0.0);
         EXPECT_EQ(torque.z(), 0.0);
-        const double spring = kr * omega * dt * k;  // kr * rolled angle
+        EXPECT_EQ(history.rollingAngle.x(), 0.0);
+        EXPECT_EQ(history.rollingAngle.z(), 0.0);  // the torsion part is not stored
+        const double angle = omega * dt * k;  // rolled angle
+        const double spring = kr * angle;
         if (spring <= limit) {
             ++elastic;
             EXPECT_LT(relativeError(-torque.y(), spring), 1e-10);
+            EXPECT_LT(relativeError(history.rollingAngle.y(), angle), 1e-10);
         } else {
             ++plastic;
             EXPECT_LT(relativeError(-torque.y(), limit), 1e-12);
+            // Full mobilisation: the stored angle is cut back to limit / kr.
+            EXPECT_LT(relativeError(history.rollingAngle.y(), limit / kr), 1e-12);
         }
     }
     EXPECT_GT(elastic, 100);
@@ -496,13 +504,103 @@ TEST(RollingEPSD, DampingTermMatchesFormulaAndIsDroppedAtFullMobilisation) {
     ContactHistory history;
     Vec3 torque = ContactLaw<RollingModel::EPSD>::evaluate(kin, props, history).rollingTorque;
     EXPECT_LT(relativeError(-torque.y(), kr * omega * dt + viscous * omega), 1e-12);
-    // The history keeps the spring part only.
-    EXPECT_LT(relativeError(-history.rollingTorque.y(), kr * omega * dt), 1e-12);
+    // The history keeps the spring's rolled angle only (no dashpot in it).
+    EXPECT_LT(relativeError(history.rollingAngle.y(), omega * dt), 1e-12);
 
-    for (int k = 2; k <= 200000 && std::abs(history.rollingTorque.y()) < limit; ++k)
+    int steps = 1;
+    for (; steps < 200000 && kr * std::abs(history.rollingAngle.y()) < limit; ++steps)
         torque = ContactLaw<RollingModel::EPSD>::evaluate(kin, props, history).rollingTorque;
+    // The limit is reached after limit / (kr w dt) steps.
+    EXPECT_NEAR(steps, limit / (kr * omega * dt), 2.0);
     torque = ContactLaw<RollingModel::EPSD>::evaluate(kin, props, history).rollingTorque;
     EXPECT_LT(relativeError(-torque.y(), limit), 1e-12);  // no dashpot when fully mobilised
+    EXPECT_LT(relativeError(history.rollingAngle.y(), limit / kr), 1e-12);
+}
+
+// The rolling spring must not create energy when the overlap (and with it kr)
+// changes.  A closed cycle of the rolled angle: roll by +a at overlap d1,
+// compress to d2 (kr grows), roll back by -a, release to d1.  The spring ends
+// where it started, unloaded.  The LIGGGHTS form, which keeps the spring
+// TORQUE and adds -kr w dt, would end with the torque (kr(d2) - kr(d1)) a and
+// the energy of that spring, taken from nowhere: repeated, this pumped the
+// wet (capillary-compressed) die-filling bed of the EPSD2 runs.
+template <RollingModel Rolling>
+void expectClosedRollingCycleLeavesTheSpringUnloaded() {
+    const InteractionProperties props = sandSand(0.5, 0.7, 0.5, 0.3);
+    const double radius = 1e-3;
+    const double mass = sphereMass(radius, kSand.density);
+    const double dt = 1e-6, omega = 0.5;
+    const double overlap1 = 2e-6, overlap2 = 8e-6;
+    const int steps = 400;  // a = 2e-4 rad: elastic at both overlaps
+    const double a = omega * dt * steps;
+    ContactKinematics kin = restingPair(overlap1, radius, mass, dt);
+    auto stiffness = [&](double overlap) {
+        const double contact = std::sqrt(kin.radiusEff * overlap);
+        return Rolling == RollingModel::EPSD
+                   ? dem::epsdRollingStiffness(4.0 / 3.0 * props.youngsEff * contact, props.rollingFriction,
+                                               kin.radiusEff)
+                   : dem::epsd2RollingStiffness(8.0 * props.shearEff * contact, kin.radiusEff);
+    };
+    const double kr1 = stiffness(overlap1), kr2 = stiffness(overlap2);
+    ASSERT_LT(kr1 * a, 0.5 * props.rollingFriction * kin.radiusEff *
+                           hertzElastic(props.youngsEff, kin.radiusEff, overlap1));
+    ASSERT_GT(kr2, 1.9 * kr1);
+
+    ContactHistory history;
+    auto roll = [&](double overlap, double w, int n) {
+        kin.overlap = overlap;
+        kin.relOmega = Vec3(0.0, w, 0.0);
+        Vec3 torque = Vec3::Zero();
+        for (int k = 0; k < n; ++k) torque = ContactLaw<Rolling>::evaluate(kin, props, history).rollingTorque;
+        return torque;
+    };
+    double oldFormTorque = 0.0;  // the LIGGGHTS torque form, for contrast
+    for (int cycle = 1; cycle <= 20; ++cycle) {
+        SCOPED_TRACE("cycle " + std::to_string(cycle));
+        roll(overlap1, omega, steps);
+        EXPECT_LT(relativeError(history.rollingAngle.y(), a), 1e-9);
+        // At rest (no dashpot): the spring torque of the current stiffness.
+        Vec3 torque = roll(overlap1, 0.0, 1);
+        EXPECT_LT(relativeError(-torque.y(), kr1 * a), 1e-9);
+        torque = roll(overlap2, 0.0, 1);  // compressed: same angle, stiffer spring
+        EXPECT_LT(relativeError(-torque.y(), kr2 * a), 1e-9);
+        roll(overlap2, -omega, steps);
+        torque = roll(overlap1, 0.0, 1);  // released
+        EXPECT_LT(std::abs(history.rollingAngle.y()), 1e-9 * a);
+        EXPECT_LT(std::abs(torque.y()), 1e-9 * kr1 * a);
+        EXPECT_EQ(torque.x(), 0.0);
+        EXPECT_EQ(torque.z(), 0.0);
+        oldFormTorque += -kr1 * a + kr2 * a;
+    }
+    // What the torque form would hold after the cycles: 20 (kr2 - kr1) a.
+    EXPECT_GT(std::abs(oldFormTorque), 20.0 * 0.9 * kr1 * a);
+}
+
+TEST(RollingEPSD2, ClosedRollingCycleUnderChangingOverlapLeavesTheSpringUnloaded) {
+    expectClosedRollingCycleLeavesTheSpringUnloaded<RollingModel::EPSD2>();
+}
+
+TEST(RollingEPSD, ClosedRollingCycleUnderChangingOverlapLeavesTheSpringUnloaded) {
+    expectClosedRollingCycleLeavesTheSpringUnloaded<RollingModel::EPSD>();
+}
+
+// The stored angle lies in the current tangent plane: when the normal turns,
+// its normal part is dropped (as for the tangential shear spring).
+TEST(RollingEPSD2, RolledAngleIsProjectedOntoTheTangentPlane) {
+    const InteractionProperties props = sandSand(0.5, 0.7, 0.5);
+    const double radius = 1e-3, overlap = 4e-6, dt = 1e-6;
+    ContactKinematics kin = restingPair(overlap, radius, sphereMass(radius, kSand.density), dt);
+    ContactHistory history;
+    history.rollingAngle = Vec3(1e-5, 2e-5, 0.0);
+    const double c = std::sqrt(0.5);
+    kin.normal = Vec3(0.0, c, c);  // turned by 45 degrees about x
+    const Vec3 torque = ContactLaw<RollingModel::EPSD2>::evaluate(kin, props, history).rollingTorque;
+    const Vec3 expected(1e-5, 1e-5, -1e-5);  // minus (theta.n) n
+    EXPECT_LT((history.rollingAngle - expected).norm(), 1e-12 * expected.norm());
+    EXPECT_NEAR(history.rollingAngle.dot(kin.normal), 0.0, 1e-20);
+    const double kr = dem::epsd2RollingStiffness(8.0 * props.shearEff * std::sqrt(kin.radiusEff * overlap),
+                                                 kin.radiusEff);
+    EXPECT_LT((torque + kr * expected).norm(), 1e-12 * kr * expected.norm());
 }
 
 // ---------------------------------------------------------------------------

@@ -332,12 +332,12 @@ void checkRepeatAndRestart(int threadCount) {
     EXPECT_GT(first.lastStep().contacts.wallContacts, 10u);
     double rollingHistory = 0.0, shearHistory = 0.0;
     for (const dem::PairState& s : first.pairList().state()) {
-        rollingHistory = std::max(rollingHistory, s.contact.rollingTorque.norm());
+        rollingHistory = std::max(rollingHistory, s.contact.rollingAngle.norm());
         shearHistory = std::max(shearHistory, s.contact.shear.norm());
     }
     EXPECT_GT(rollingHistory, 0.0);
     EXPECT_GT(shearHistory, 0.0);
-    std::printf("restart point (%d threads): %zu touching pairs, %zu wall contacts, max |rolling torque| %.3e N m\n",
+    std::printf("restart point (%d threads): %zu touching pairs, %zu wall contacts, max |rolling angle| %.3e rad\n",
                 threadCount, first.lastStep().contacts.touchingPairs, first.lastStep().contacts.wallContacts,
                 rollingHistory);
     first.writeRestart(path);

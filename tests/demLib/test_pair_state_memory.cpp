@@ -4,9 +4,13 @@
 // force allocated on first write.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <string>
 #include <vector>
 
 #include "demLib/contact_history_pool.hpp"
+#include "demLib/error.hpp"
+#include "demLib/hdf5_file.hpp"
 #include "demLib/simulation.hpp"
 #include "contact_history_testing.hpp"
 #include "thread_count.hpp"
@@ -103,7 +107,7 @@ TEST(PairStateMemory, HistoryOnlyForTouchingPairsAndOnlyTheModelsParts) {
     sim.particles().omega[0] = Vec3(0, 0, 50.0);  // rolls on 1: the rolling spring winds up
     sim.step(20);
     const auto& list = sim.pairList();
-    EXPECT_TRUE(list.stateFields().rollingTorque);
+    EXPECT_TRUE(list.stateFields().rollingSpring);
     EXPECT_FALSE(list.stateFields().bridgeVolume);
     EXPECT_TRUE(list.bridgeVolume().empty());
     ASSERT_EQ(list.pairCount(), 2u);  // (0,1) touching and (1,2) within the skin
@@ -113,18 +117,18 @@ TEST(PairStateMemory, HistoryOnlyForTouchingPairsAndOnlyTheModelsParts) {
     const dem::PairState near = list.state()[1];      // pair (1, 2)
     // Particle 0 moves +y relative to 1: the tangential spring stretches along +y.
     EXPECT_GT(touching.contact.shear.y(), 0.0);
-    EXPECT_GT(touching.contact.rollingTorque.norm(), 0.0);
+    EXPECT_GT(touching.contact.rollingAngle.norm(), 0.0);
     EXPECT_EQ(near.contact.shear, Vec3::Zero());
-    EXPECT_EQ(near.contact.rollingTorque, Vec3::Zero());
+    EXPECT_EQ(near.contact.rollingAngle, Vec3::Zero());
 
     // CDT keeps no rolling spring, and dry runs no bridge volumes.
     dem::Simulation cdt = twoTouchingAndOneNear(dem::RollingModel::CDT, dem::CohesionModel::None);
     cdt.step(20);
     dem::Simulation epsd2 = twoTouchingAndOneNear(dem::RollingModel::EPSD2, dem::CohesionModel::None);
     epsd2.step(20);
-    EXPECT_FALSE(cdt.pairList().stateFields().rollingTorque);
+    EXPECT_FALSE(cdt.pairList().stateFields().rollingSpring);
     EXPECT_EQ(cdt.pairList().history().stride(), 3u);
-    EXPECT_EQ(cdt.pairList().state()[0].contact.rollingTorque, Vec3::Zero());
+    EXPECT_EQ(cdt.pairList().state()[0].contact.rollingAngle, Vec3::Zero());
     EXPECT_GT(cdt.pairList().state()[0].contact.shear.y(), 0.0);
     // Without spin the tangential spring does not depend on the rolling model.
     EXPECT_EQ(cdt.pairList().state()[0].contact.shear, epsd2.pairList().state()[0].contact.shear);
@@ -169,6 +173,69 @@ TEST(PairStateMemory, ContactThatOpensForgetsItsHistoryAndTakesItsRecordBackWhen
         EXPECT_EQ(pool.records(), 1u);
         EXPECT_GT(sim.pairList().state()[0].contact.shear.norm(), 0.0);
     }
+}
+
+// Restart files keep the rolling springs as angles ("rollingAngle").  Files
+// of the builds that kept them as torques hold "rollingTorque": continued when
+// it is all zero (runs without EPSD/EPSD2), refused otherwise.  Such a file is
+// made here by renaming the datasets of a new one.
+void renameRollingDatasetsToTheTorqueForm(const std::string& path) {
+    dem::Hdf5File f(path, dem::Hdf5File::Mode::Update);
+    for (const std::string group : {"pairs", "wallContacts"}) {
+        ASSERT_TRUE(f.exists(group + "/rollingAngle"));
+        ASSERT_FALSE(f.exists(group + "/rollingTorque"));
+        f.rename(group + "/rollingAngle", group + "/rollingTorque");
+    }
+}
+
+TEST(PairStateRestart, OldFileWithRollingSpringTorquesIsRefusedNamingTheFile) {
+    ThreadCount threads(1);
+    dem::Simulation sim = twoTouchingAndOneNear(dem::RollingModel::EPSD2, dem::CohesionModel::None);
+    sim.particles().omega[0] = Vec3(0, 0, 50.0);  // the rolling spring winds up
+    sim.step(20);
+    ASSERT_GT(sim.pairList().state()[0].contact.rollingAngle.norm(), 0.0);
+    const std::string path = ::testing::TempDir() + "pair_state_old_rolling_torque.h5";
+    sim.writeRestart(path);
+    renameRollingDatasetsToTheTorqueForm(path);
+
+    dem::Simulation continued = twoTouchingAndOneNear(dem::RollingModel::EPSD2, dem::CohesionModel::None);
+    try {
+        continued.readRestart(path);
+        ADD_FAILURE() << "a restart file with non-zero rolling spring torques was read";
+    } catch (const dem::InputError& e) {
+        const std::string what = e.what();
+        std::printf("refused: %s\n", what.c_str());
+        EXPECT_NE(what.find(path), std::string::npos) << what;
+        EXPECT_NE(what.find("pairs/rollingTorque"), std::string::npos) << what;
+        EXPECT_NE(what.find("rolling springs as torques"), std::string::npos) << what;
+        EXPECT_NE(what.find("continue the run with the build that wrote"), std::string::npos) << what;
+    }
+    std::remove(path.c_str());
+}
+
+TEST(PairStateRestart, OldFileWithZeroRollingTorquesContinuesBitwise) {
+    ThreadCount threads(1);
+    // CDT keeps no rolling spring: its files hold zeros in the rolling datasets.
+    dem::Simulation first = twoTouchingAndOneNear(dem::RollingModel::CDT, dem::CohesionModel::None);
+    first.particles().omega[0] = Vec3(0, 0, 50.0);
+    first.step(20);
+    ASSERT_GT(first.pairList().state()[0].contact.shear.norm(), 0.0);
+    const std::string path = ::testing::TempDir() + "pair_state_old_zero_torque.h5";
+    first.writeRestart(path);
+    renameRollingDatasetsToTheTorqueForm(path);
+    first.step(30);
+
+    dem::Simulation continued = twoTouchingAndOneNear(dem::RollingModel::CDT, dem::CohesionModel::None);
+    continued.readRestart(path);
+    EXPECT_EQ(continued.stepCount(), 20);
+    EXPECT_EQ(continued.pairList().history().contactsWithHistory(), 1u);
+    continued.step(30);
+    for (std::size_t i = 0; i < first.particles().size(); ++i) {
+        EXPECT_EQ(continued.particles().position[i], first.particles().position[i]) << "particle " << i;
+        EXPECT_EQ(continued.particles().velocity[i], first.particles().velocity[i]) << "particle " << i;
+        EXPECT_EQ(continued.particles().omega[i], first.particles().omega[i]) << "particle " << i;
+    }
+    std::remove(path.c_str());
 }
 
 TEST(ExternalForceField, AllocatedOnFirstWriteAndFollowsTheParticles) {

@@ -283,13 +283,6 @@ CaseSetup readCaseSetup(const Dictionary& root, const std::string& caseDir) {
             // Particle-wall bridges (sphere-plane form), off by default: the paper
             // models particle-particle bridges only.
             s.forces.wallBridges = coh.getOrDefault<bool>("wallBridges", false);
-            if (s.forces.rolling == RollingModel::EPSD || s.forces.rolling == RollingModel::EPSD2)
-                c.warnings.push_back(
-                    model.describe("rolling") + ": '" + rolling + "' with 'cohesion { model capillary; }' can " +
-                    "gain energy without bound: its spring keeps a torque (as in LIGGGHTS) while its stiffness " +
-                    "follows the overlap, which the capillary pull makes large and changing (a wet die fill " +
-                    "reached 5e-2 J of kinetic energy where 'cdt' stays near 1e-5 J; docs/capillary-model.md, " +
-                    "\"Rolling springs and capillary bridges\").  Use 'cdt' or 'none' with capillary cohesion.");
         }
     }
 

@@ -82,8 +82,8 @@ public:
         // normally configured it so; this only adds missing ones).
         const PairStateFields need = PairStateFields::forModels(Rolling, Cohesion == CohesionModel::Capillary);
         const PairStateFields have = pairs.stateFields();
-        if ((need.rollingTorque && !have.rollingTorque) || (need.bridgeVolume && !have.bridgeVolume))
-            pairs.setStateFields({have.rollingTorque || need.rollingTorque, have.bridgeVolume || need.bridgeVolume});
+        if ((need.rollingSpring && !have.rollingSpring) || (need.bridgeVolume && !have.bridgeVolume))
+            pairs.setStateFields({have.rollingSpring || need.rollingSpring, have.bridgeVolume || need.bridgeVolume});
         const int n = static_cast<int>(p.size());
         const int threads = threadsFor(n, heavyLoopParticlesPerThread);
         // Each thread adds into the particle arrays for its own rows and into its
@@ -361,13 +361,13 @@ private:
                 double* record = s >= 0 ? records + s * stride : nullptr;
                 if (record) {
                     history.shear = Vec3::Map(record);
-                    if constexpr (keepsRolling) history.rollingTorque = Vec3::Map(record + 3);
+                    if constexpr (keepsRolling) history.rollingAngle = Vec3::Map(record + 3);
                 }
                 const ContactForces f =
                     Law::evaluate(kin, interactions(p.material[i], p.material[j]), history, cohesiveForce);
                 if (double* out = recordToWrite(slot, k, records, stride)) {
                     Vec3::Map(out) = history.shear;
-                    if constexpr (keepsRolling) Vec3::Map(out + 3) = history.rollingTorque;
+                    if constexpr (keepsRolling) Vec3::Map(out + 3) = history.rollingAngle;
                 } else {
                     changes.opened.push_back({k, history});
                 }
@@ -535,7 +535,7 @@ private:
                 } else {
                     ContactHistory history;
                     history.shear = Vec3(b.sx[e], b.sy[e], b.sz[e]);
-                    if constexpr (keepsRolling) history.rollingTorque = Vec3(b.mx[e], b.my[e], b.mz[e]);
+                    if constexpr (keepsRolling) history.rollingAngle = Vec3(b.mx[e], b.my[e], b.mz[e]);
                     changes.opened.push_back({b.entry[e], history});
                 }
             }

@@ -13,7 +13,7 @@ void ContactHistoryPool::setRolling(bool keep) {
     const std::size_t slots = slotCount();
     const std::size_t oldStride = stride();
     rolling_ = keep;
-    // Re-pack the records with the new stride (shear kept, rolling torque zero).
+    // Re-pack the records with the new stride (shear kept, rolling angle zero).
     std::vector<double> data(slots * stride(), 0.0);
     for (std::size_t s = 0; s < slots; ++s)
         for (int c = 0; c < 3; ++c) data[s * stride() + c] = data_[s * oldStride + c];
@@ -115,7 +115,7 @@ void ContactHistoryPool::set(std::size_t k, const ContactHistory& h) {
     if (wake(slot_[k]) < 0) slot_[k] = takeSlot();
     double* r = record(slot_[k]);
     Vec3::Map(r) = h.shear;
-    if (rolling_) Vec3::Map(r + 3) = h.rollingTorque;
+    if (rolling_) Vec3::Map(r + 3) = h.rollingAngle;
 }
 
 void ContactHistoryPool::commit(const std::vector<Changes>& changes) {

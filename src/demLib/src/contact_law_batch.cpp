@@ -148,21 +148,24 @@ DEM_ALWAYS_INLINE void evaluateBatchBody(ContactBatch& b, int count, double dt, 
                 stiffness = kt * radiusEff * radiusEff;
             }
             const double torqueLimit = (Uniform ? muR0 : muRLane[e]) * radiusEff * limitingNormalForce;
-            // elasticPlasticRollingTorque
+            // elasticPlasticRollingTorque: b.mx/my/mz hold the rolled angle
             const double omegaNormal = omx * nx + omy * ny + omz * nz;
             const double wtx = omx - omegaNormal * nx;
             const double wty = omy - omegaNormal * ny;
             const double wtz = omz - omegaNormal * nz;
-            const double increment = stiffness * dt;
-            const double mx = mxs[e] - increment * wtx;
-            const double my = mys[e] - increment * wty;
-            const double mz = mzs[e] - increment * wtz;
-            const double springSquared = mx * mx + my * my + mz * mz;
-            const bool limited = springSquared > torqueLimit * torqueLimit;
-            const double limitScale = torqueLimit / std::sqrt(springSquared);
-            mxs[e] = limited ? mx * limitScale : mx;
-            mys[e] = limited ? my * limitScale : my;
-            mzs[e] = limited ? mz * limitScale : mz;
+            double thx = mxs[e] + wtx * dt, thy = mys[e] + wty * dt, thz = mzs[e] + wtz * dt;
+            const double angleNormal = thx * nx + thy * ny + thz * nz;
+            thx = thx - angleNormal * nx;
+            thy = thy - angleNormal * ny;
+            thz = thz - angleNormal * nz;
+            const double negativeStiffness = -stiffness;
+            const double mx = negativeStiffness * thx, my = negativeStiffness * thy, mz = negativeStiffness * thz;
+            const double torqueSquared = mx * mx + my * my + mz * mz;
+            const bool limited = torqueSquared > torqueLimit * torqueLimit;
+            const double limitScale = torqueLimit / std::sqrt(torqueSquared);
+            mxs[e] = limited ? thx * limitScale : thx;
+            mys[e] = limited ? thy * limitScale : thy;
+            mzs[e] = limited ? thz * limitScale : thz;
             rtx = limited ? mx * limitScale : mx - viscous * wtx;
             rty = limited ? my * limitScale : my - viscous * wty;
             rtz = limited ? mz * limitScale : mz - viscous * wtz;

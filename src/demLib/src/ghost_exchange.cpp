@@ -76,23 +76,23 @@ void unpackParticle(ByteReader& r, ParticleStore& p) {
 
 void packHistory(ByteWriter& w, const ContactHistory& h) {
     w.put(h.shear);
-    w.put(h.rollingTorque);
+    w.put(h.rollingAngle);
 }
 
 ContactHistory unpackHistory(ByteReader& r) {
     ContactHistory h;
     h.shear = r.vec();
-    h.rollingTorque = r.vec();
+    h.rollingAngle = r.vec();
     return h;
 }
 
-bool isBlank(const ContactHistory& h) { return h.shear.isZero(0.0) && h.rollingTorque.isZero(0.0); }
+bool isBlank(const ContactHistory& h) { return h.shear.isZero(0.0) && h.rollingAngle.isZero(0.0); }
 
 // History vectors are defined for the first particle of a pair: seen from the
 // other one they change sign (as in ParticleParticleNeighborList::remap).
 PairState seenFromOther(PairState s) {
     s.contact.shear = -s.contact.shear;
-    s.contact.rollingTorque = -s.contact.rollingTorque;
+    s.contact.rollingAngle = -s.contact.rollingAngle;
     return s;
 }
 

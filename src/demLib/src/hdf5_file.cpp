@@ -55,7 +55,7 @@ Hdf5File::Hdf5File(const std::string& path, Mode mode) : path_(path) {
     if (mode == Mode::Create)
         file_ = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
     else
-        file_ = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+        file_ = H5Fopen(path.c_str(), mode == Mode::Update ? H5F_ACC_RDWR : H5F_ACC_RDONLY, H5P_DEFAULT);
     if (file_ < 0)
         throw InputError("HDF5 file '" + path + "': cannot " +
                          std::string(mode == Mode::Create ? "create it" : "open it (missing or not HDF5)"));
@@ -71,6 +71,11 @@ void Hdf5File::createGroup(const std::string& name) {
 }
 
 bool Hdf5File::exists(const std::string& name) const { return H5Lexists(file_, name.c_str(), H5P_DEFAULT) > 0; }
+
+void Hdf5File::rename(const std::string& from, const std::string& to) {
+    if (H5Lmove(file_, from.c_str(), file_, to.c_str(), H5P_DEFAULT, H5P_DEFAULT) < 0)
+        fail(path_, "cannot rename '" + from + "' to '" + to + "'");
+}
 
 void Hdf5File::write(const std::string& name, const std::vector<double>& data, std::size_t columns) {
     writeDataset(file_, path_, name, H5T_NATIVE_DOUBLE, data.data(), data.size() / columns, columns);

@@ -16,7 +16,7 @@ namespace dem {
 
 void ParticleParticleNeighborList::setStateFields(const PairStateFields& fields) {
     if (fields == fields_) return;
-    history_.setRolling(fields.rollingTorque);
+    history_.setRolling(fields.rollingSpring);
     if (fields.bridgeVolume != fields_.bridgeVolume) {
         if (fields.bridgeVolume)
             bridgeVolume_.assign(neighbors_.size(), 0.0);
@@ -81,7 +81,7 @@ bool ParticleParticleNeighborList::setState(int i, int j, const PairState& s) {
 
 void ParticleParticleNeighborList::setStateAt(std::size_t k, const PairState& s) {
     // Zero history is what "no slot" means already.
-    if (!s.contact.shear.isZero(0.0) || (fields_.rollingTorque && !s.contact.rollingTorque.isZero(0.0)))
+    if (!s.contact.shear.isZero(0.0) || (fields_.rollingSpring && !s.contact.rollingAngle.isZero(0.0)))
         history_.set(k, s.contact);
     if (fields_.bridgeVolume) bridgeVolume_[k] = s.bridgeVolume;
 }

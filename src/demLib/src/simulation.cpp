@@ -160,7 +160,7 @@ void Simulation::setWaterContent(double w) {
     liquid_.poolVolume += volume - liquid_.totalVolume;
     liquid_.totalVolume = volume;
     liquidNetwork_ = std::make_unique<LiquidBridgeNetwork>(volume, settings_.bridges);
-    pairs_.setStateFields({pairs_.stateFields().rollingTorque, true});
+    pairs_.setStateFields({pairs_.stateFields().rollingSpring, true});
     largestBridge_ = 0.0;
     bridgeListingLimit_ = std::numeric_limits<double>::infinity();  // λ unknown for the new total
     forcesValid_ = false;

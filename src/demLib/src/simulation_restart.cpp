@@ -15,6 +15,27 @@ namespace dem {
 
 namespace {
 constexpr const char* restartFormat = "diefill-demLib-restart-1";
+
+// The EPSD/EPSD2 rolling springs of group ("pairs" or "wallContacts"), kept as
+// rolled angles [rad] in "<group>/rollingAngle".  Files written before the
+// springs became angles hold "<group>/rollingTorque" instead (the spring as a
+// torque [N m]); it is zero in every run without EPSD/EPSD2 (CDT, none), and
+// such files continue as before.  A non-zero torque cannot be continued: its
+// angle would need the stiffness the old build used, and the run would not
+// continue as it would have with that build.
+std::vector<Vec3> readRollingSprings(const Hdf5File& f, const std::string& group) {
+    const std::string angle = group + "/rollingAngle";
+    if (f.exists(angle)) return f.readVec3(angle);
+    const std::string torque = group + "/rollingTorque";
+    std::vector<Vec3> springs = f.readVec3(torque);
+    for (const Vec3& m : springs)
+        if (!m.isZero(0.0))
+            throw InputError("restart file '" + f.path() + "' was written by a build that kept the EPSD/EPSD2 "
+                             "rolling springs as torques (non-zero dataset '" + torque + "'); this build keeps "
+                             "them as angles ('" + angle + "'): continue the run with the build that wrote the "
+                             "file, or start it again");
+    return springs;  // all zero: the same as zero angles
+}
 }
 
 void Simulation::writeRestart(const std::string& path) const {
@@ -70,18 +91,18 @@ void Simulation::writeRestart(const std::string& path) const {
         for (std::size_t i = 0; i + 1 < offsets.size(); ++i)
             for (int k = offsets[i]; k < offsets[i + 1]; ++k) {
                 const PairState s = state[k];
-                if (s.bridgeVolume == 0.0 && s.contact.shear.isZero(0.0) && s.contact.rollingTorque.isZero(0.0))
+                if (s.bridgeVolume == 0.0 && s.contact.shear.isZero(0.0) && s.contact.rollingAngle.isZero(0.0))
                     continue;
                 ids.push_back(p.id[i]);
                 ids.push_back(p.id[neighbors[k]]);
                 shear.push_back(s.contact.shear);
-                rolling.push_back(s.contact.rollingTorque);
+                rolling.push_back(s.contact.rollingAngle);
                 bridge.push_back(s.bridgeVolume);
             }
         f.createGroup("pairs");
         f.write("pairs/ids", ids, 2);
         f.write("pairs/shear", shear);
-        f.write("pairs/rollingTorque", rolling);
+        f.write("pairs/rollingAngle", rolling);
         f.write("pairs/bridgeVolume", bridge);
 
         std::vector<std::int64_t> wallKeys;
@@ -92,14 +113,14 @@ void Simulation::writeRestart(const std::string& path) const {
             wallKeys.push_back(r.wall);
             wallKeys.push_back(r.feature);
             wShear.push_back(r.history.shear);
-            wRolling.push_back(r.history.rollingTorque);
+            wRolling.push_back(r.history.rollingAngle);
             wBridge.push_back(r.bridgeVolume);
             wForce.push_back(r.force);
         }
         f.createGroup("wallContacts");
         f.write("wallContacts/keys", wallKeys, 3);
         f.write("wallContacts/shear", wShear);
-        f.write("wallContacts/rollingTorque", wRolling);
+        f.write("wallContacts/rollingAngle", wRolling);
         f.write("wallContacts/bridgeVolume", wBridge);
         f.write("wallContacts/force", wForce);
     }
@@ -167,7 +188,7 @@ void Simulation::readRestart(const std::string& path) {
     liquidNetwork_.reset();
     if (f.intAttribute("hasLiquid")) {
         liquidNetwork_ = std::make_unique<LiquidBridgeNetwork>(liquid_.totalVolume, settings_.bridges);
-        pairs_.setStateFields({pairs_.stateFields().rollingTorque, true});
+        pairs_.setStateFields({pairs_.stateFields().rollingSpring, true});
     }
 
     std::unordered_map<std::int64_t, int> indexOf;
@@ -192,12 +213,12 @@ void Simulation::readRestart(const std::string& path) {
     pairs_.restore(particles_, f.readVec3("particles/positionAtListBuild"), f.intAttribute("listBuildCount"));
     const auto ids = f.readInt64("pairs/ids");
     const auto shear = f.readVec3("pairs/shear");
-    const auto rolling = f.readVec3("pairs/rollingTorque");
+    const auto rolling = readRollingSprings(f, "pairs");
     const auto bridge = f.readDoubles("pairs/bridgeVolume");
     for (std::size_t k = 0; k < shear.size(); ++k) {
         PairState s;
         s.contact.shear = shear[k];
-        s.contact.rollingTorque = rolling[k];
+        s.contact.rollingAngle = rolling[k];
         s.bridgeVolume = bridge[k];
         if (!pairs_.setState(lookup(ids[2 * k]), lookup(ids[2 * k + 1]), s))
             throw InputError("restart file '" + path + "': saved pair (" + std::to_string(ids[2 * k]) + ", " +
@@ -208,7 +229,7 @@ void Simulation::readRestart(const std::string& path) {
     records.clear();
     const auto keys = f.readInt64("wallContacts/keys");
     const auto wShear = f.readVec3("wallContacts/shear");
-    const auto wRolling = f.readVec3("wallContacts/rollingTorque");
+    const auto wRolling = readRollingSprings(f, "wallContacts");
     const auto wBridge = f.readDoubles("wallContacts/bridgeVolume");
     // Files from before the wall forces were kept: zero until the next step.
     const auto wForce = f.exists("wallContacts/force") ? f.readVec3("wallContacts/force") : std::vector<Vec3>();
@@ -218,7 +239,7 @@ void Simulation::readRestart(const std::string& path) {
         r.wall = static_cast<int>(keys[3 * k + 1]);
         r.feature = static_cast<int>(keys[3 * k + 2]);
         r.history.shear = wShear[k];
-        r.history.rollingTorque = wRolling[k];
+        r.history.rollingAngle = wRolling[k];
         r.bridgeVolume = wBridge[k];
         if (k < wForce.size()) r.force = wForce[k];
         // A run continued without wall bridges: their liquid waits in the pool.

@@ -25,7 +25,7 @@ namespace dem {
 
 class ContactHistoryPool {
 public:
-    // Whether the rolling spring torque is kept (EPSD models); otherwise it reads as zero.
+    // Whether the rolling spring (rolled angle) is kept (EPSD models); otherwise it reads as zero.
     void setRolling(bool keep);
     bool keepsRolling() const { return rolling_; }
 
@@ -69,7 +69,7 @@ public:
         const int s = slot_[k];
         if (s >= 0) {
             h.shear = Vec3::Map(&data_[s * stride()]);
-            if (rolling_) h.rollingTorque = Vec3::Map(&data_[s * stride() + 3]);
+            if (rolling_) h.rollingAngle = Vec3::Map(&data_[s * stride() + 3]);
         }
         return h;
     }
@@ -81,7 +81,7 @@ public:
 
     // Hot-loop access for the force kernel: the slot of each entry, and the
     // records: slot s holds the shear at record(s) and, if keepsRolling(), the
-    // rolling torque right after it (one cache line per contact, not two).
+    // rolled angle right after it (one cache line per contact, not two).
     int* slots() { return slot_.data(); }
     int slot(std::size_t k) const { return slot_[k]; }
     double* record(int s) { return data_.data() + static_cast<std::size_t>(s) * stride(); }

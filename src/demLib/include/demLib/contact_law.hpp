@@ -3,6 +3,8 @@
 // tangential history rolling_friction {off|cdt|epsd|epsd2}' (and the matching
 // 'fix wall/gran'), composed from the per-part headers.  Everything is inline,
 // allocation-free and resolved at compile time (if constexpr, no virtual calls).
+// One departure from LIGGGHTS: the EPSD/EPSD2 rolling spring is kept as an
+// angle, not a torque (see elasticPlasticRollingTorque).
 // Formulas, references and conventions: docs/contact-models.md.
 //
 // Conventions
@@ -54,7 +56,7 @@ struct ContactKinematics {
 
 struct ContactHistory {
     Vec3 shear = Vec3::Zero();          // tangential spring displacement [m]
-    Vec3 rollingTorque = Vec3::Zero();  // EPSD/EPSD2 spring torque on i [N m]
+    Vec3 rollingAngle = Vec3::Zero();   // EPSD/EPSD2 rolling spring: angle rolled by i relative to j [rad]
 };
 
 struct ContactForces {
@@ -109,7 +111,7 @@ struct ContactLaw {
                 stiffness = epsd2RollingStiffness(hertz.tangentialStiffness, kin.radiusEff);
             }
             rollingTorque = elasticPlasticRollingTorque(
-                history.rollingTorque, omega, kin.normal, kin.dt, stiffness,
+                history.rollingAngle, omega, kin.normal, kin.dt, stiffness,
                 props.rollingFriction * kin.radiusEff * limitingNormalForce, viscous);
         }
 

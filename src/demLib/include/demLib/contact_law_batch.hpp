@@ -36,7 +36,7 @@ struct ContactBatch {
     // and 1 for a touching pair, 0 for a bridge beyond contact (force = cohesive
     // force along the normal, no torque, no history)
     alignas(64) double extraNormalForce[capacity], touching[capacity];
-    // history, read and written: shear displacement, EPSD/EPSD2 spring torque
+    // history, read and written: shear displacement, EPSD/EPSD2 rolled angle
     alignas(64) double sx[capacity], sy[capacity], sz[capacity], mx[capacity], my[capacity], mz[capacity];
     // outputs: total force on i (j gets the opposite), torques on i and on j
     alignas(64) double fx[capacity], fy[capacity], fz[capacity];

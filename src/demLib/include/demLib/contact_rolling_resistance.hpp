@@ -47,24 +47,43 @@ inline double rollingInertiaWall(double mass, double radius) noexcept {
     return 1.4 * mass * radius * radius;
 }
 
-// EPSD and EPSD2 share this update.  springTorque (in ContactHistory, torque on i)
-// is advanced incrementally with the tangential part w_t of omega:
-//   M  -= kr w_t dt
-//   if |M| > Mmax:  M *= Mmax/|M|, stored, returned without damping (full mobilisation)
-//   else:           stored; returned M - c w_t  with c = eta_r 2 sqrt(I_r kr) (EPSD) or 0 (EPSD2)
+// EPSD and EPSD2 share this update.  The rolling spring is kept as the rolled
+// ANGLE theta [rad] (in ContactHistory, of i relative to j), advanced with the
+// tangential part w_t of omega and projected onto the current tangent plane as
+// the tangential shear spring is; the spring torque is evaluated from it with
+// the CURRENT stiffness:
+//   theta += w_t dt;  theta -= (theta.n) n
+//   M = -kr theta
+//   if |M| > Mmax:  theta *= Mmax/|M| (so that |kr theta| = Mmax), returned
+//                   M Mmax/|M| without damping (full mobilisation)
+//   else:           returned M - c w_t  with c = eta_r 2 sqrt(I_r kr) (EPSD) or 0 (EPSD2)
 // Mmax = mu_r R* |Fn| with Fn the total normal force of the normal model.
-DEM_ALWAYS_INLINE Vec3 elasticPlasticRollingTorque(Vec3& springTorque, const Vec3& omega, const Vec3& normal,
+//
+// This departs from LIGGGHTS 3.8, which keeps the spring TORQUE M and
+// increments it, M -= kr w_t dt.  kr depends on the current overlap (EPSD:
+// kn ~ sqrt(R* d); EPSD2: kt ~ sqrt(R* d)), so a stored torque keeps its value
+// while kr changes, and the spring energy M^2/(2 kr) changes without work: an
+// overlap that oscillates (contacts compressed by capillary bridges) pumps
+// energy into the rolling springs.  An angle gives the energy kr theta^2/2 of
+// the current stiffness, which returns to zero when the rolled angle does.
+// For a constant kr and omega in the tangent plane both forms give the same
+// torques.
+DEM_ALWAYS_INLINE Vec3 elasticPlasticRollingTorque(Vec3& springAngle, const Vec3& omega, const Vec3& normal,
                                         double dt, double rollingStiffness, double torqueLimit,
                                         double viscousCoefficient) noexcept {
     const Vec3 omegaTangential = omega - omega.dot(normal) * normal;
-    springTorque -= (rollingStiffness * dt) * omegaTangential;
+    springAngle += omegaTangential * dt;
+    springAngle -= springAngle.dot(normal) * normal;
+    Vec3 torque = -rollingStiffness * springAngle;
     // |M| > Mmax in squared form (both >= 0): the root only when the limit is reached.
-    const double springMagnitudeSquared = springTorque.squaredNorm();
-    if (springMagnitudeSquared > torqueLimit * torqueLimit) {
-        springTorque *= torqueLimit / std::sqrt(springMagnitudeSquared);
-        return springTorque;
+    const double torqueSquared = torque.squaredNorm();
+    if (torqueSquared > torqueLimit * torqueLimit) {
+        const double scale = torqueLimit / std::sqrt(torqueSquared);
+        springAngle *= scale;
+        torque *= scale;
+        return torque;
     }
-    return springTorque - viscousCoefficient * omegaTangential;
+    return torque - viscousCoefficient * omegaTangential;
 }
 
 }  // namespace dem

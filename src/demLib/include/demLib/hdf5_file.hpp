@@ -11,7 +11,8 @@ namespace dem {
 
 class Hdf5File {
 public:
-    enum class Mode { Create, Read };
+    // Create (or truncate), Read only, or Update (an existing file, read and write).
+    enum class Mode { Create, Read, Update };
     Hdf5File(const std::string& path, Mode mode);
     ~Hdf5File();
     Hdf5File(const Hdf5File&) = delete;
@@ -21,6 +22,8 @@ public:
 
     void createGroup(const std::string& name);
     bool exists(const std::string& name) const;
+    // Renames (moves) a dataset or group; the target's group must exist.
+    void rename(const std::string& from, const std::string& to);
 
     void write(const std::string& name, const std::vector<double>& data, std::size_t columns = 1);
     void write(const std::string& name, const std::vector<std::int64_t>& data, std::size_t columns = 1);

@@ -23,16 +23,16 @@ struct PairState {
 
 // Which parts of PairState a run keeps.  The list stores each part as its own
 // array parallel to the pairs; a part that is off costs no memory and reads as
-// zero: the rolling spring torque exists only for the EPSD models, the bridge
+// zero: the rolling spring (rolled angle) exists only for the EPSD models, the bridge
 // volume only with cohesion.  The tangential spring (shear) is always kept.
 struct PairStateFields {
-    bool rollingTorque = true;
+    bool rollingSpring = true;
     bool bridgeVolume = true;
     static PairStateFields forModels(RollingModel rolling, bool cohesion) {
         return {rolling == RollingModel::EPSD || rolling == RollingModel::EPSD2, cohesion};
     }
     bool operator==(const PairStateFields& o) const {
-        return rollingTorque == o.rollingTorque && bridgeVolume == o.bridgeVolume;
+        return rollingSpring == o.rollingSpring && bridgeVolume == o.bridgeVolume;
     }
 };
 
