@@ -178,12 +178,13 @@ def die_geometry(d):
     return radius, z1 - z0, z0, opening
 
 
-def wall_load_results(s, props, until, mass_in_system, mass_in_die, out, shoe_end=None):
+def wall_load_results(s, props, until, opening, mass_in_system, mass_in_die, out, shoe_end=None):
     """What the walls carry (the wallForce_<wall>_z columns of summary.csv, force of the
-    particles on each wall): the loads in grams-force against time (wallLoads.png), and
-    before time `until` (a mean, see below) the share of the weight of all particles the walls carry together
-    (1 at rest without air) and the share of the die's powder weight on the die base
-    (below 1: the die wall holds the rest by friction, Janssen)."""
+    particles on each wall): the loads in grams-force against time (wallLoads.png, the die's
+    `opening` marked once the run is past it), and, as means before time `until` (see below),
+    the share of the weight of all particles the walls carry together (1 at rest without air)
+    and the share of the die's powder weight on the die base (below 1: the die wall holds the
+    rest by friction, Janssen)."""
     names = [k[len("wallForce_"):-2] for k in s if k.startswith("wallForce_") and k.endswith("_z")]
     if not names:
         return {}
@@ -193,7 +194,7 @@ def wall_load_results(s, props, until, mass_in_system, mass_in_die, out, shoe_en
     plots.curve(os.path.join(out, "wallLoads.png"), t, [loads[w] * 1e3 for w in names] + [s["mass_die"] * 1e3],
                 ["load on %s" % w for w in names] + ["mass in the die"], "time [s]", "[g]",
                 title="weight carried by the walls (force of the particles / g)",
-                vlines=[(until, "die opening starts")])
+                vlines=[(opening, "die opening starts")] if opening <= t[-1] else ())
     # Averaged over the lines between the shoe's pass (if it ended before) and `until`, at
     # most 0.5 s: a wet bed standing on a few contacts rattles, and at the opening's start the
     # die wall begins to slide along the bed.
@@ -262,7 +263,7 @@ def report_before_opening(case, out, props, s, frames, poured, fill, opening, en
                               with_air, wet, "the part simulated so far"))
     if with_air:
         res.update(case_air_results(case, props, min(opening, float(t[-1])), out, s)[0])
-    res.update(wall_load_results(s, props, float(t[-1]), poured - float(s["lostMass"][-1]),
+    res.update(wall_load_results(s, props, float(t[-1]), opening, poured - float(s["lostMass"][-1]),
                                  float(s["mass_die"][-1]), out, shoe_pass[1] if shoe_pass else None))
     if run_time is not None:
         res["runTime"] = {"value": run_time, "unit": "s", "description": "wall time of the run"}
@@ -393,7 +394,7 @@ def main():
         res["runTime"] = {"value": a.runTime, "unit": "s", "description": "wall time of demRun"}
     res["simulatedTime"] = {"value": float(t[-1]), "unit": "s",
                             "description": "last time in dem/summary.csv (the case ends at %g s)" % end_time}
-    res.update(wall_load_results(s, props, opening, poured - lost_before_opening, mass_die_filled, out,
+    res.update(wall_load_results(s, props, opening, opening, poured - lost_before_opening, mass_die_filled, out,
                                  shoe_pass[1] if shoe_pass else None))
     if in_progress:
         print("dieFilling.py: the run is not finished (t = %g s of %g s): the figures below are those "

@@ -255,8 +255,8 @@ def fluidisation(args):
     buoyancy = n * volume * rho * g
     closure = (fluid + support) / weight_n - 1
     exchange = (plateau * area - (fluid - buoyancy)) / weight_n
-    expected = (weight * area - support) / (weight * area)
-    err_supported = (plateau * area - (weight * area - support)) / (weight * area)
+    expected = 1 - support / (weight * area)  # the share of the buoyant weight the air carries
+    err_supported = plateau / weight - expected
     print(f"    plateau window {t0:.4f}-{t1:.4f} s, in units of the beads' weight: fluid force {fluid / weight_n:.4f}, "
           "walls' support " + ", ".join(f"{w} {f / weight_n + 0.0:.4f}" for w, f in per_wall.items()))
     print(f"    beads: fluid force + support - weight = {closure:+.2e} (tolerance 1e-2); air: pressure drop x area "

@@ -34,7 +34,6 @@ long firstIndexAfter(double time, double interval) {
 
 CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream& log)
     : setup_(std::move(setup)), options_(options), log_(log) {
-    for (const std::string& warning : setup_.warnings) log_ << "Warning: " << warning << "\n";
     simulation_ = makeSimulation(setup_);
     const fs::path out = outputDirectory();
     fs::create_directories(out / "restart");

@@ -60,9 +60,6 @@ struct CaseSetup {
     double endTime = 0.0;
     double waterContent = 0.0;  // > 0 with the capillary model
     CoarseGrainSettings coarseGrain;
-    // Accepted but known to behave badly (each names the file and the
-    // keywords); the runner writes them at the top of its log.
-    std::vector<std::string> warnings;
 
     int materialIndex(const std::string& name) const;  // -1 if unknown
 };
