@@ -232,6 +232,8 @@ CaseSetup readCaseSetup(const Dictionary& root, const std::string& caseDir) {
     s.allowLargeTimeStep = sim.getOrDefault<bool>("allowLargeTimeStep", false);
     if (sim.has("maxHertzFraction")) s.maxHertzFraction = sim.getInRange("maxHertzFraction", 1e-3, 1.0);
     if (sim.has("impactVelocity")) s.impactVelocity = sim.getPositive("impactVelocity");
+    if (sim.has("maxCapillaryClusterFraction"))
+        s.maxCapillaryClusterFraction = sim.getInRange("maxCapillaryClusterFraction", 1e-3, 1.0);
     if (sim.has("domain")) {
         const Dictionary& box = sim.subDict("domain");
         AxisAlignedBox b{box.get<Vec3>("min"), box.get<Vec3>("max")};

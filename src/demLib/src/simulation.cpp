@@ -5,6 +5,7 @@
 #include <limits>
 #include <sstream>
 
+#include "demLib/contact_stability.hpp"
 #include "demLib/error.hpp"
 #include "demLib/integrator.hpp"
 #include "demLib/parallel.hpp"
@@ -25,14 +26,19 @@ std::string formatVec(const Vec3& v) {
 // settings allow a large time step), naming both values.
 void requireTimeStepBelow(const SimulationSettings& settings, const Simulation::TimeStepLimits& limits,
                           const std::string& context) {
-    const double allowed = std::min(limits.rayleigh, limits.hertz);
+    const double allowed = limits.smallest();
     if (settings.timeStep > allowed && !settings.allowLargeTimeStep) {
         std::ostringstream s;
         s << settings.source << ": keyword 'timeStep' = " << settings.timeStep << " s is too large for the contact "
           << "stiffness after " << context << ": " << settings.maxRayleighFraction
           << " x the Rayleigh time of the smallest particle allows " << limits.rayleigh << " s, "
           << settings.maxHertzFraction << " x its Hertz collision time at " << settings.impactVelocity
-          << " m/s (keyword 'impactVelocity') allows " << limits.hertz << " s; expected timeStep <= " << allowed
+          << " m/s (keyword 'impactVelocity') allows " << limits.hertz << " s";
+        if (std::isfinite(limits.capillary))
+            s << ", " << settings.maxCapillaryClusterFraction << " x the stable step of the smallest particle "
+              << "pressed by capillary bridges into six of the largest (keyword 'maxCapillaryClusterFraction'; "
+              << "beyond it a wet bed rattles) allows " << limits.capillary << " s";
+        s << "; expected timeStep <= " << allowed
           << " (or set 'allowLargeTimeStep true' to override, at your own risk)";
         throw InputError(s.str());
     }
@@ -53,6 +59,8 @@ Simulation::Simulation(SimulationSettings settings, std::vector<Material> materi
         throw InputError(src + ": keyword 'skinFraction' expects a positive fraction of the largest diameter");
     if (!(settings_.maxRayleighFraction > 0.0))
         throw InputError(src + ": keyword 'maxRayleighFraction' expects a positive number");
+    if (!(settings_.maxCapillaryClusterFraction > 0.0))
+        throw InputError(src + ": keyword 'maxCapillaryClusterFraction' expects a positive number");
     if (materials_.empty()) throw InputError(src + ": no material defined; expected at least one in 'materials'");
     for (const Material& m : materials_) validateMaterial(m);
     interactions_.requireComplete(materials_);
@@ -116,8 +124,12 @@ void Simulation::insert(const std::vector<InsertedParticle>& inserted, int mater
 
 Simulation::TimeStepLimits Simulation::timeStepLimits(const std::vector<InsertedParticle>& adding,
                                                       int materialIndex) const {
-    TimeStepLimits limits{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
-    auto consider = [&](double radius, const Material& m) {
+    constexpr double infinity = std::numeric_limits<double>::infinity();
+    TimeStepLimits limits{infinity, infinity, infinity};
+    double smallestRadius = infinity, largestRadius = 0.0;
+    int smallestMaterial = 0, largestMaterial = 0;
+    auto consider = [&](double radius, int material) {
+        const Material& m = materials_[material];
         limits.rayleigh = std::min(limits.rayleigh, settings_.maxRayleighFraction * criticalTimeStep(m, radius));
         // Two equal spheres head-on: LIGGGHTS uses the particle mass, R/2 and
         // the pair's Y*, at twice the characteristic speed.
@@ -125,16 +137,22 @@ Simulation::TimeStepLimits Simulation::timeStepLimits(const std::vector<Inserted
         const double hertz =
             hertzCollisionTime(mass, 0.5 * radius, effectiveYoungsModulus(m, m), 2.0 * settings_.impactVelocity);
         limits.hertz = std::min(limits.hertz, settings_.maxHertzFraction * hertz);
+        if (radius < smallestRadius) smallestRadius = radius, smallestMaterial = material;
+        if (radius > largestRadius) largestRadius = radius, largestMaterial = material;
     };
-    for (std::size_t i = 0; i < particles_.size(); ++i) consider(particles_.radius[i], materials_[particles_.material[i]]);
-    for (const InsertedParticle& q : adding) consider(q.radius, materials_[materialIndex]);
+    for (std::size_t i = 0; i < particles_.size(); ++i) consider(particles_.radius[i], particles_.material[i]);
+    for (const InsertedParticle& q : adding) consider(q.radius, materialIndex);
+    if (settings_.forces.cohesion == CohesionModel::Capillary && largestRadius > 0.0)
+        limits.capillary = settings_.maxCapillaryClusterFraction *
+                           capillaryClusterStableTimeStep(smallestRadius, materials_[smallestMaterial], largestRadius,
+                                                          materials_[largestMaterial],
+                                                          interactions_(smallestMaterial, largestMaterial),
+                                                          settings_.forces.capillary,
+                                                          settings_.forces.capillaryForceScale);
     return limits;
 }
 
-double Simulation::maxAllowedTimeStep() const {
-    const TimeStepLimits limits = timeStepLimits();
-    return std::min(limits.rayleigh, limits.hertz);
-}
+double Simulation::maxAllowedTimeStep() const { return timeStepLimits().smallest(); }
 
 void Simulation::setDecomposition(std::shared_ptr<GhostExchange> decomposition) {
     if (!particles_.empty() || nextId_ != 0)

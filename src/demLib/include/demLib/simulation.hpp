@@ -1,4 +1,5 @@
 #pragma once
+#include <algorithm>
 // The DEM engine's front door: configuration structs in, state and fields out.
 // A Simulation owns the particles, the walls, the contact lists and the force
 // kernel, and advances them with velocity Verlet.
@@ -45,6 +46,11 @@ struct SimulationSettings {
     // fix check/timestep/gran estimate).
     double maxHertzFraction = 0.1;
     double impactVelocity = 1.0;  // [m/s], the largest speed expected in the run
+    // ... and, with capillary cohesion, not exceed this fraction of the step at
+    // which the explicit integration of the smallest particle, pressed by its
+    // bridges into six of the largest, turns unstable (contact_stability.hpp):
+    // beyond it a wet bed at rest rattles.
+    double maxCapillaryClusterFraction = 1.0;
     // Systems of at least this many particles are sorted in space now and then
     // (see Simulation::updatePairList); smaller ones keep their order.
     std::size_t spatialSortMinParticles = 4096;
@@ -140,11 +146,13 @@ public:
     std::vector<Vec3> wallForces() const;
 
     // Largest time step the settings accept for the particles present, and the
-    // two limits it is the smaller of.
+    // limits it is the smallest of.
     double maxAllowedTimeStep() const;
     struct TimeStepLimits {
-        double rayleigh;  // maxRayleighFraction x smallest Rayleigh time
-        double hertz;     // maxHertzFraction x smallest Hertz collision time
+        double rayleigh;   // maxRayleighFraction x smallest Rayleigh time
+        double hertz;      // maxHertzFraction x smallest Hertz collision time
+        double capillary;  // maxCapillaryClusterFraction x stable step of a wet grain (infinite when dry)
+        double smallest() const { return std::min(rayleigh, std::min(hertz, capillary)); }
     };
     TimeStepLimits timeStepLimits(const std::vector<InsertedParticle>& adding = {}, int materialIndex = 0) const;
 

@@ -1,0 +1,126 @@
+#include "demLib/contact_stability.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace dem {
+
+namespace {
+
+constexpr double pi = 3.14159265358979323846;
+
+Eigen::Matrix3d crossMatrix(const Eigen::Vector3d& v) {
+    Eigen::Matrix3d m;
+    m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+    return m;
+}
+
+double sphereMass(double radius, double density) { return density * 4.0 / 3.0 * pi * radius * radius * radius; }
+
+}  // namespace
+
+LinearContact linearHertzContact(const InteractionProperties& props, double radiusEff, double massEff,
+                                 double overlap) {
+    const double contactRadius = std::sqrt(radiusEff * overlap);  // a = sqrt(R* d)
+    const double dampingScale = std::sqrt(contactRadius * massEff);
+    LinearContact c;
+    // The elastic force is (4/3 Y*) a d, so its tangent stiffness dF/dd is 1.5 times the secant one.
+    c.normalStiffness = 1.5 * props.normalStiffnessFactor * contactRadius;
+    c.tangentialStiffness = props.tangentialStiffnessFactor * contactRadius;
+    c.normalDamping = props.normalDampingFactor * dampingScale;
+    c.tangentialDamping = props.tangentialDampingFactor * dampingScale;
+    return c;
+}
+
+void addContact(ContactClusterModel& model, double radius, const Eigen::Vector3d& normal,
+                const LinearContact& contact) {
+    const Eigen::Vector3d n = normal.normalized();
+    const Eigen::Matrix3d normalPart = n * n.transpose();
+    const Eigen::Matrix3d tangentPart = Eigen::Matrix3d::Identity() - normalPart;
+    // Velocity of the contact point R n: v + w x (R n) = v - R [n]x w.  Its
+    // tangential part is B_t q', its normal part B_n q'; a force F there acts on
+    // q as (F, R n x F) = B^T F for either part, so each spring adds B^T k B.
+    Eigen::Matrix<double, 3, 6> tangential;
+    tangential << tangentPart, -radius * tangentPart * crossMatrix(n);
+    Eigen::Matrix<double, 3, 6> normalRow;
+    normalRow << normalPart, Eigen::Matrix3d::Zero();
+    model.stiffness += contact.tangentialStiffness * tangential.transpose() * tangential +
+                       contact.normalStiffness * normalRow.transpose() * normalRow;
+    model.damping += contact.tangentialDamping * tangential.transpose() * tangential +
+                     contact.normalDamping * normalRow.transpose() * normalRow;
+}
+
+ContactClusterModel cubicContactCluster(double radius, double mass, const LinearContact& contact) {
+    ContactClusterModel model;
+    const double inertia = 0.4 * mass * radius * radius;
+    model.mass.diagonal() << mass, mass, mass, inertia, inertia, inertia;
+    for (int axis = 0; axis < 3; ++axis)
+        for (double side : {1.0, -1.0}) addContact(model, radius, side * Eigen::Vector3d::Unit(axis), contact);
+    return model;
+}
+
+double verletSpectralRadius(const ContactClusterModel& model, double dt) {
+    // With u = the half-step velocity v(n - 1/2), which the forces of step n
+    // see: u' = u + dt a(x, u), x' = x + dt u',  a = -M^-1 (K x + C u).
+    const Eigen::Matrix<double, 6, 6> massInverse = model.mass.inverse();
+    const Eigen::Matrix<double, 6, 6> identity = Eigen::Matrix<double, 6, 6>::Identity();
+    const Eigen::Matrix<double, 6, 6> velocityFromVelocity = identity - dt * massInverse * model.damping;
+    const Eigen::Matrix<double, 6, 6> velocityFromPosition = -dt * massInverse * model.stiffness;
+    Eigen::Matrix<double, 12, 12> step;
+    step.topLeftCorner<6, 6>() = identity + dt * velocityFromPosition;
+    step.topRightCorner<6, 6>() = dt * velocityFromVelocity;
+    step.bottomLeftCorner<6, 6>() = velocityFromPosition;
+    step.bottomRightCorner<6, 6>() = velocityFromVelocity;
+    const Eigen::EigenSolver<Eigen::Matrix<double, 12, 12>> solver(step, false);
+    return solver.eigenvalues().cwiseAbs().maxCoeff();
+}
+
+double verletStableTimeStep(const ContactClusterModel& model) {
+    const Eigen::Matrix<double, 6, 6> massInverse = model.mass.inverse();
+    const double stiffest = (massInverse * model.stiffness).eigenvalues().cwiseAbs().maxCoeff();
+    const double fastestDamping = (massInverse * model.damping).eigenvalues().cwiseAbs().maxCoeff();
+    if (!(stiffest > 0.0) && !(fastestDamping > 0.0)) return std::numeric_limits<double>::infinity();
+    constexpr double tolerance = 1e-7;
+    auto stable = [&](double dt) { return verletSpectralRadius(model, dt) <= 1.0 + tolerance; };
+    // The undamped limit 2/w is an upper bound on the damped one; the doubling
+    // only guards against a model whose bound is not reached there.
+    double high = stiffest > 0.0 ? 2.0 / std::sqrt(stiffest) : 2.0 / fastestDamping;
+    for (int k = 0; k < 60 && stable(high); ++k) high *= 2.0;
+    double low = 0.0;
+    while (high - low > 1e-9 * high) {
+        const double mid = 0.5 * (low + high);
+        (stable(mid) ? low : high) = mid;
+    }
+    return low;
+}
+
+double capillaryContactForceBound(double radius1, double radius2, const CapillaryParameters& capillary,
+                                  double forceScale) {
+    const double larger = std::max(radius1, radius2);
+    double strongest = 0.0;
+    for (double reducedVolume = 1e-5; reducedVolume <= 1.0001e-1; reducedVolume *= std::sqrt(10.0)) {
+        const CapillaryBridgeFit fit =
+            capillaryBridgeFit(radius1, radius2, reducedVolume * larger * larger * larger, capillary);
+        strongest = std::max(strongest, std::abs(fit.contactForce));
+    }
+    return forceScale * strongest;
+}
+
+double capillaryClusterStableTimeStep(double radius, const Material& material, double neighbourRadius,
+                                      const Material& neighbourMaterial, const InteractionProperties& props,
+                                      const CapillaryParameters& capillary, double forceScale) {
+    const double mass = sphereMass(radius, material.density);
+    const double neighbourMass = sphereMass(neighbourRadius, neighbourMaterial.density);
+    const double radiusEff = radius * neighbourRadius / (radius + neighbourRadius);
+    const double massEff = mass * neighbourMass / (mass + neighbourMass);
+    const double force = capillaryContactForceBound(radius, neighbourRadius, capillary, forceScale);
+    if (!(force > 0.0)) return std::numeric_limits<double>::infinity();
+    // Hertz: F = (4/3 Y*) sqrt(R*) d^(3/2).
+    const double overlap = std::pow(force / (props.normalStiffnessFactor * std::sqrt(radiusEff)), 2.0 / 3.0);
+    return verletStableTimeStep(
+        cubicContactCluster(radius, mass, linearHertzContact(props, radiusEff, massEff, overlap)));
+}
+
+}  // namespace dem
