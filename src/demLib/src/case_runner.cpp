@@ -140,6 +140,16 @@ void CaseRunner::performDueInsertions() {
             simulation_->setWaterContent(setup_.waterContent);
             log_ << ", liquid now " << simulation_->liquid().totalVolume << " m^3 (w = " << setup_.waterContent << ")";
         }
+        if (n > 0) {
+            // How close the run is to the time-step limits (docs/engine.md), and which one binds.
+            const Simulation::TimeStepLimits limits = simulation_->timeStepLimits();
+            const double allowed = limits.smallest();
+            const char* binding = allowed == limits.capillary ? "wet-bed"
+                                  : allowed == limits.hertz   ? "Hertz"
+                                                              : "Rayleigh";
+            log_ << "; time step " << simulation_->timeStep() / allowed << " of the largest allowed, " << allowed
+                 << " s (" << binding << " limit)";
+        }
         if (placed_ < population_.size()) {
             if (n == 0 && simulation_->particles().size() == before && spec.waveInterval <= 0.0)
                 throw InputError(spec.context + ": no particle fits in the region");
