@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "demLib/contact_rolling_resistance.hpp"
 #include "demLib/contact_stability.hpp"
 #include "demLib/error.hpp"
 #include "demLib/simulation.hpp"
@@ -69,20 +70,23 @@ TEST(ContactStability, HeavierDampingAndMoreContactsLowerTheLimit) {
 // contact, whose sliding mode (translation and spin together, effective mass
 // m/3.5) is the fastest.  Given a small sliding velocity, the contact point's
 // slip dies out below the predicted step and grows above it.
-double slipAfter(double dtFactor) {
+double slipAfter(double dtFactor, dem::RollingModel rolling = dem::RollingModel::None) {
     OneThread oneThread;
     const dem::Material glass{"glass", 5e6, 0.3, 2500.0};
     const std::vector<dem::Material> mats{glass};
     dem::PairCoefficients c;
     c.restitution = 0.1;
     c.friction = 0.5;
+    c.rollingFriction = 0.5;
+    c.rollingViscousDamping = 0.3;
     const dem::InteractionTable table = tableFor(mats, c);
     const double r = 1e-3, m = 2500.0 * 4.0 / 3.0 * kPi * r * r * r, g = 9.81;
     // Rest on a wall: R* = R, m* = m; m g = (4/3 Y*) sqrt(R) d^1.5.
     const double overlap = std::pow(m * g / (table(0, 0).normalStiffnessFactor * std::sqrt(r)), 2.0 / 3.0);
     dem::ContactClusterModel model;
     model.mass.diagonal() << m, m, m, 0.4 * m * r * r, 0.4 * m * r * r, 0.4 * m * r * r;
-    dem::addContact(model, r, -Vec3::UnitZ(), dem::linearHertzContact(table(0, 0), r, m, overlap));
+    dem::addContact(model, r, -Vec3::UnitZ(),
+                    dem::linearHertzContact(table(0, 0), r, m, overlap, rolling, dem::rollingInertiaWall(m, r)));
     const double predicted = dem::verletStableTimeStep(model);
 
     dem::SimulationSettings settings;
@@ -90,6 +94,7 @@ double slipAfter(double dtFactor) {
     settings.gravity = Vec3(0, 0, -g);
     settings.allowLargeTimeStep = true;  // the point is to go beyond the limit
     settings.source = "test_contact_stability";
+    settings.forces.rolling = rolling;
     dem::Simulation sim(settings, mats, table,
                         {dem::Wall{"floor", dem::PlaneWall(Vec3::Zero(), Vec3::UnitZ()), dem::WallMotion(), 0}});
     sim.insert({{Vec3(0, 0, r - 0.99e-6 * r), r}}, 0, Vec3(1e-5, 0, 0));
@@ -112,6 +117,29 @@ TEST(ContactStability, EngineTurnsUnstableWhereTheModelSays) {
     // 1e-5 m/s at the start) and 5e-3 m/s, capped by friction, at 1.01-1.1 x.
     EXPECT_LT(slipAfter(0.98), 1e-7) << "slip at 0.98 x the predicted step";
     EXPECT_GT(slipAfter(1.02), 1e-4) << "slip at 1.02 x the predicted step";
+    // With a rolling spring (EPSD2) or spring and dashpot (EPSD, eta_r = 0.3) in the
+    // model as in the contact law, the onset moves with it.
+    for (dem::RollingModel rolling : {dem::RollingModel::EPSD2, dem::RollingModel::EPSD}) {
+        EXPECT_LT(slipAfter(0.98, rolling), 1e-7) << "rolling model " << static_cast<int>(rolling);
+        EXPECT_GT(slipAfter(1.02, rolling), 1e-4) << "rolling model " << static_cast<int>(rolling);
+    }
+}
+
+// EPSD2's rolling spring stiffens the spin modes: a lower limit than CDT's.
+TEST(ContactStability, RollingSpringLowersTheWetLimit) {
+    const dem::Material sand{"sand", 5e6, 0.3, 2650.0};
+    dem::PairCoefficients c;
+    c.restitution = 0.1;
+    c.friction = 0.7;
+    c.rollingFriction = 0.5;
+    const dem::InteractionProperties props = dem::makeInteraction(sand, sand, c);
+    const double scale = std::pow(5.0, 2.0142);
+    auto limit = [&](dem::RollingModel rolling) {
+        return dem::capillaryClusterStableTimeStep(0.225e-3, sand, 1.25e-3, sand, props, dem::CapillaryParameters{},
+                                                   scale, rolling);
+    };
+    EXPECT_EQ(limit(dem::RollingModel::CDT), limit(dem::RollingModel::None));
+    EXPECT_LT(limit(dem::RollingModel::EPSD2), 0.99 * limit(dem::RollingModel::CDT));
 }
 
 // Eq 1 at contact: pi gamma sqrt(R1 R2) (exp(B) + C), largest at the smallest

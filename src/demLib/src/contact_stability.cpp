@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "demLib/contact_rolling_resistance.hpp"
+
 namespace dem {
 
 namespace {
@@ -22,7 +24,7 @@ double sphereMass(double radius, double density) { return density * 4.0 / 3.0 * 
 }  // namespace
 
 LinearContact linearHertzContact(const InteractionProperties& props, double radiusEff, double massEff,
-                                 double overlap) {
+                                 double overlap, RollingModel rolling, double rollingInertia) {
     const double contactRadius = std::sqrt(radiusEff * overlap);  // a = sqrt(R* d)
     const double dampingScale = std::sqrt(contactRadius * massEff);
     LinearContact c;
@@ -31,6 +33,14 @@ LinearContact linearHertzContact(const InteractionProperties& props, double radi
     c.tangentialStiffness = props.tangentialStiffnessFactor * contactRadius;
     c.normalDamping = props.normalDampingFactor * dampingScale;
     c.tangentialDamping = props.tangentialDampingFactor * dampingScale;
+    if (rolling == RollingModel::EPSD2) {
+        c.rollingStiffness = epsd2RollingStiffness(c.tangentialStiffness, radiusEff);
+    } else if (rolling == RollingModel::EPSD) {
+        // EPSD's stiffness is built on the secant normal stiffness, as in the contact law.
+        c.rollingStiffness = epsdRollingStiffness(props.normalStiffnessFactor * contactRadius,
+                                                  props.rollingFriction, radiusEff);
+        c.rollingDamping = props.rollingViscousDamping * 2.0 * std::sqrt(rollingInertia * c.rollingStiffness);
+    }
     return c;
 }
 
@@ -50,6 +60,9 @@ void addContact(ContactClusterModel& model, double radius, const Eigen::Vector3d
                        contact.normalStiffness * normalRow.transpose() * normalRow;
     model.damping += contact.tangentialDamping * tangential.transpose() * tangential +
                      contact.normalDamping * normalRow.transpose() * normalRow;
+    // The rolling spring resists the rotation's part in the tangent plane (neighbour fixed).
+    model.stiffness.bottomRightCorner<3, 3>() += contact.rollingStiffness * tangentPart;
+    model.damping.bottomRightCorner<3, 3>() += contact.rollingDamping * tangentPart;
 }
 
 ContactClusterModel cubicContactCluster(double radius, double mass, const LinearContact& contact) {
@@ -110,7 +123,8 @@ double capillaryContactForceBound(double radius1, double radius2, const Capillar
 
 double capillaryClusterStableTimeStep(double radius, const Material& material, double neighbourRadius,
                                       const Material& neighbourMaterial, const InteractionProperties& props,
-                                      const CapillaryParameters& capillary, double forceScale) {
+                                      const CapillaryParameters& capillary, double forceScale,
+                                      RollingModel rolling) {
     const double mass = sphereMass(radius, material.density);
     const double neighbourMass = sphereMass(neighbourRadius, neighbourMaterial.density);
     const double radiusEff = radius * neighbourRadius / (radius + neighbourRadius);
@@ -119,8 +133,9 @@ double capillaryClusterStableTimeStep(double radius, const Material& material, d
     if (!(force > 0.0)) return std::numeric_limits<double>::infinity();
     // Hertz: F = (4/3 Y*) sqrt(R*) d^(3/2).
     const double overlap = std::pow(force / (props.normalStiffnessFactor * std::sqrt(radiusEff)), 2.0 / 3.0);
-    return verletStableTimeStep(
-        cubicContactCluster(radius, mass, linearHertzContact(props, radiusEff, massEff, overlap)));
+    const double rollingInertia = rollingInertiaEff(mass, radius, neighbourMass, neighbourRadius);
+    return verletStableTimeStep(cubicContactCluster(
+        radius, mass, linearHertzContact(props, radiusEff, massEff, overlap, rolling, rollingInertia)));
 }
 
 }  // namespace dem

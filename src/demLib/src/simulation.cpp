@@ -148,7 +148,8 @@ Simulation::TimeStepLimits Simulation::timeStepLimits(const std::vector<Inserted
                                                           materials_[largestMaterial],
                                                           interactions_(smallestMaterial, largestMaterial),
                                                           settings_.forces.capillary,
-                                                          settings_.forces.capillaryForceScale);
+                                                          settings_.forces.capillaryForceScale,
+                                                          settings_.forces.rolling);
     return limits;
 }
 

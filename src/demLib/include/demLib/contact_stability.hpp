@@ -16,6 +16,7 @@
 #include <Eigen/Core>
 
 #include "demLib/capillary_force.hpp"
+#include "demLib/contact_law.hpp"
 #include "demLib/interaction_properties.hpp"
 
 namespace dem {
@@ -30,18 +31,24 @@ struct ContactClusterModel {
 };
 
 // Springs and dashpots of one contact, linearised at its overlap (tangent
-// normal stiffness dF/dd = 2 Y* a, tangential k_t = 8 G* a, a = sqrt(R* d)).
+// normal stiffness dF/dd = 2 Y* a, tangential k_t = 8 G* a, a = sqrt(R* d);
+// the rolling spring of EPSD/EPSD2 acts on the rotation's tangential part).
 struct LinearContact {
     double normalStiffness = 0.0;      // [N/m]
     double tangentialStiffness = 0.0;  // [N/m]
     double normalDamping = 0.0;        // [kg/s]
     double tangentialDamping = 0.0;    // [kg/s]
+    double rollingStiffness = 0.0;     // [N m/rad]
+    double rollingDamping = 0.0;       // [N m s/rad]
 };
 
 // The Hertz-Mindlin contact of `props` at overlap d (> 0) between bodies of
-// effective radius and mass radiusEff, massEff, linearised.
+// effective radius and mass radiusEff, massEff, linearised, with the rolling
+// spring (and EPSD's dashpot) of `rolling` in its elastic range; CDT and none
+// add no spring.  rollingInertia: EPSD's I_r (rollingInertiaEff).
 LinearContact linearHertzContact(const InteractionProperties& props, double radiusEff, double massEff,
-                                 double overlap);
+                                 double overlap, RollingModel rolling = RollingModel::None,
+                                 double rollingInertia = 0.0);
 
 // A sphere (radius, mass, moment of inertia 0.4 m R^2) with one contact of the
 // same law towards each of the six directions +-x, +-y, +-z.
@@ -69,9 +76,10 @@ double capillaryContactForceBound(double radius1, double radius2, const Capillar
 // bed, pressed by capillary bridges into six of the largest particles
 // (neighbourRadius, neighbourMaterial) around it: each contact carries the
 // capillary force at contact, compressed to the Hertz overlap of that force.
-// `props` is the interaction of the two materials.
+// `props` is the interaction of the two materials, `rolling` the run's model.
 double capillaryClusterStableTimeStep(double radius, const Material& material, double neighbourRadius,
                                       const Material& neighbourMaterial, const InteractionProperties& props,
-                                      const CapillaryParameters& capillary, double forceScale);
+                                      const CapillaryParameters& capillary, double forceScale,
+                                      RollingModel rolling = RollingModel::None);
 
 }  // namespace dem
