@@ -17,7 +17,13 @@
 #                               TUTORIAL_DEM_SECONDS
 #   tutorial_clean_air          removes the mesh, 0/, the time folders and the air's outputs
 
-tutorial_usage() { awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; }
+# The Allrun scripts cd to their own folder first, so a relative $0 given from elsewhere
+# (./tutorials/dieFilling/Allrun -help) is found by its base name.
+tutorial_usage() {
+    local script=$0
+    [ -f "$script" ] || script=$(basename "$0")
+    awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$script"
+}
 
 tutorial_parse_args() {
     QUICK=0; ROLLING=""; THREADS=1
