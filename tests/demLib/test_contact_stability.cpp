@@ -4,9 +4,11 @@
 // floor turns unstable within 2 % of the predicted step), and the capillary
 // time-step limit of Simulation.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -209,6 +211,30 @@ TEST(ContactStability, WetBedTimeStepLimitIsChecked) {
     dem::Simulation dryBed(dry, mats, table, {});
     EXPECT_NO_THROW(dryBed.insert(bed, 0, Vec3::Zero()));
     EXPECT_TRUE(std::isinf(dryBed.timeStepLimits().capillary));
+
+    // A restart file written beyond the limit (forced) is not continued without the override.
+    dem::SimulationSettings forcedSettings = wetSettings(1.05 * limit, scale);
+    forcedSettings.allowLargeTimeStep = true;
+    dem::Simulation forced(forcedSettings, mats, table, {});
+    forced.insert(bed, 0, Vec3::Zero());
+    forced.step(2);
+    const std::string path =
+        (std::filesystem::temp_directory_path() / ("test_contact_stability_" + std::to_string(::getpid()) + ".h5"))
+            .string();
+    forced.writeRestart(path);
+    dem::Simulation continued(wetSettings(1.05 * limit, scale), mats, table, {});
+    try {
+        continued.readRestart(path);
+        ADD_FAILURE() << "a restart beyond the wet-bed limit was continued";
+    } catch (const dem::InputError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("restart file '" + path + "'"), std::string::npos) << what;
+        EXPECT_NE(what.find("maxCapillaryClusterFraction"), std::string::npos) << what;
+    }
+    dem::Simulation overridden(forcedSettings, mats, table, {});
+    EXPECT_NO_THROW(overridden.readRestart(path));
+    EXPECT_EQ(overridden.particles().size(), 2u);
+    std::filesystem::remove(path);
 }
 
 }  // namespace

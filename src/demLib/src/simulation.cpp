@@ -155,6 +155,10 @@ Simulation::TimeStepLimits Simulation::timeStepLimits(const std::vector<Inserted
 
 double Simulation::maxAllowedTimeStep() const { return timeStepLimits().smallest(); }
 
+void Simulation::requireAllowedTimeStep(const std::string& context) const {
+    requireTimeStepBelow(settings_, timeStepLimits(), context);
+}
+
 void Simulation::setDecomposition(std::shared_ptr<GhostExchange> decomposition) {
     if (!particles_.empty() || nextId_ != 0)
         throw InputError(settings_.source + ": the domain decomposition must be set before any particle is inserted");

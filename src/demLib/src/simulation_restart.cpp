@@ -251,6 +251,8 @@ void Simulation::readRestart(const std::string& path) {
     }
     std::sort(records.begin(), records.end());
     rebuildWallCandidates();
+    // A case written before a limit was added (or tightened) is not continued beyond it.
+    requireAllowedTimeStep("restart file '" + path + "'");
 }
 
 }  // namespace dem

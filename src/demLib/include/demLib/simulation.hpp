@@ -155,6 +155,10 @@ public:
         double smallest() const { return std::min(rayleigh, std::min(hertz, capillary)); }
     };
     TimeStepLimits timeStepLimits(const std::vector<InsertedParticle>& adding = {}, int materialIndex = 0) const;
+    // Throws InputError naming the limits, `context` and the settings' source
+    // when the time step exceeds them (unless allowLargeTimeStep); insert() and
+    // readRestart() call it.
+    void requireAllowedTimeStep(const std::string& context) const;
 
     // Restart: the whole state, contact history included.
     void writeRestart(const std::string& path) const;
