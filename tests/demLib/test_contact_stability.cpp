@@ -57,7 +57,7 @@ TEST(ContactStability, HeavierDampingAndMoreContactsLowerTheLimit) {
     // Tangent stiffness of Hertz: dF/dd = 2 Y* sqrt(R* d).
     EXPECT_NEAR(contact.normalStiffness, 2.0 * props.youngsEff * std::sqrt(0.5 * r * 1e-6),
                 1e-12 * contact.normalStiffness);
-    const double six = dem::verletStableTimeStep(dem::cubicContactCluster(r, m, contact));
+    const double six = dem::verletStableTimeStep(dem::cubicContactCluster(r, m, contact, r));
     dem::ContactClusterModel two;
     two.mass.diagonal() << m, m, m, 0.4 * m * r * r, 0.4 * m * r * r, 0.4 * m * r * r;
     dem::addContact(two, r, Vec3::UnitZ(), contact);
@@ -65,7 +65,7 @@ TEST(ContactStability, HeavierDampingAndMoreContactsLowerTheLimit) {
     EXPECT_LT(six, dem::verletStableTimeStep(two));
     dem::LinearContact undamped = contact;
     undamped.normalDamping = undamped.tangentialDamping = 0.0;
-    EXPECT_LT(six, 0.8 * dem::verletStableTimeStep(dem::cubicContactCluster(r, m, undamped)));
+    EXPECT_LT(six, 0.8 * dem::verletStableTimeStep(dem::cubicContactCluster(r, m, undamped, r)));
 }
 
 // A sphere resting on a floor under gravity, with heavy damping (e = 0.1): one

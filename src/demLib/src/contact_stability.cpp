@@ -44,16 +44,16 @@ LinearContact linearHertzContact(const InteractionProperties& props, double radi
     return c;
 }
 
-void addContact(ContactClusterModel& model, double radius, const Eigen::Vector3d& normal,
+void addContact(ContactClusterModel& model, double leverArm, const Eigen::Vector3d& normal,
                 const LinearContact& contact) {
     const Eigen::Vector3d n = normal.normalized();
     const Eigen::Matrix3d normalPart = n * n.transpose();
     const Eigen::Matrix3d tangentPart = Eigen::Matrix3d::Identity() - normalPart;
-    // Velocity of the contact point R n: v + w x (R n) = v - R [n]x w.  Its
+    // Velocity of the contact point c n: v + w x (c n) = v - c [n]x w.  Its
     // tangential part is B_t q', its normal part B_n q'; a force F there acts on
-    // q as (F, R n x F) = B^T F for either part, so each spring adds B^T k B.
+    // q as (F, c n x F) = B^T F for either part, so each spring adds B^T k B.
     Eigen::Matrix<double, 3, 6> tangential;
-    tangential << tangentPart, -radius * tangentPart * crossMatrix(n);
+    tangential << tangentPart, -leverArm * tangentPart * crossMatrix(n);
     Eigen::Matrix<double, 3, 6> normalRow;
     normalRow << normalPart, Eigen::Matrix3d::Zero();
     model.stiffness += contact.tangentialStiffness * tangential.transpose() * tangential +
@@ -65,12 +65,12 @@ void addContact(ContactClusterModel& model, double radius, const Eigen::Vector3d
     model.damping.bottomRightCorner<3, 3>() += contact.rollingDamping * tangentPart;
 }
 
-ContactClusterModel cubicContactCluster(double radius, double mass, const LinearContact& contact) {
+ContactClusterModel cubicContactCluster(double radius, double mass, const LinearContact& contact, double leverArm) {
     ContactClusterModel model;
     const double inertia = 0.4 * mass * radius * radius;
     model.mass.diagonal() << mass, mass, mass, inertia, inertia, inertia;
     for (int axis = 0; axis < 3; ++axis)
-        for (double side : {1.0, -1.0}) addContact(model, radius, side * Eigen::Vector3d::Unit(axis), contact);
+        for (double side : {1.0, -1.0}) addContact(model, leverArm, side * Eigen::Vector3d::Unit(axis), contact);
     return model;
 }
 
@@ -92,6 +92,8 @@ double verletSpectralRadius(const ContactClusterModel& model, double dt) {
 
 double verletStableTimeStep(const ContactClusterModel& model) {
     const Eigen::Matrix<double, 6, 6> massInverse = model.mass.inverse();
+    // A model with a non-finite entry (from non-finite input) has no stable step.
+    if (!model.mass.allFinite() || !model.stiffness.allFinite() || !model.damping.allFinite()) return 0.0;
     const double stiffest = (massInverse * model.stiffness).eigenvalues().cwiseAbs().maxCoeff();
     const double fastestDamping = (massInverse * model.damping).eigenvalues().cwiseAbs().maxCoeff();
     if (!(stiffest > 0.0) && !(fastestDamping > 0.0)) return std::numeric_limits<double>::infinity();
@@ -134,8 +136,12 @@ double capillaryClusterStableTimeStep(double radius, const Material& material, d
     // Hertz: F = (4/3 Y*) sqrt(R*) d^(3/2).
     const double overlap = std::pow(force / (props.normalStiffnessFactor * std::sqrt(radiusEff)), 2.0 / 3.0);
     const double rollingInertia = rollingInertiaEff(mass, radius, neighbourMass, neighbourRadius);
-    return verletStableTimeStep(cubicContactCluster(
-        radius, mass, linearHertzContact(props, radiusEff, massEff, overlap, rolling, rollingInertia)));
+    LinearContact contact = linearHertzContact(props, radiusEff, massEff, overlap, rolling, rollingInertia);
+    const double mobility = 1.0 + mass / neighbourMass;
+    for (double* part : {&contact.normalStiffness, &contact.tangentialStiffness, &contact.normalDamping,
+                         &contact.tangentialDamping, &contact.rollingStiffness, &contact.rollingDamping})
+        *part *= mobility;
+    return verletStableTimeStep(cubicContactCluster(radius, mass, contact, radius - 0.5 * overlap));
 }
 
 }  // namespace dem

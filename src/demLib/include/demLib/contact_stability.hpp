@@ -51,10 +51,11 @@ LinearContact linearHertzContact(const InteractionProperties& props, double radi
                                  double rollingInertia = 0.0);
 
 // A sphere (radius, mass, moment of inertia 0.4 m R^2) with one contact of the
-// same law towards each of the six directions +-x, +-y, +-z.
-ContactClusterModel cubicContactCluster(double radius, double mass, const LinearContact& contact);
+// same law towards each of the six directions +-x, +-y, +-z, at `leverArm` from
+// its centre (the engine's c = R - d/2).
+ContactClusterModel cubicContactCluster(double radius, double mass, const LinearContact& contact, double leverArm);
 // The same with one contact of outward normal `normal` (the side it touches).
-void addContact(ContactClusterModel& model, double radius, const Eigen::Vector3d& normal,
+void addContact(ContactClusterModel& model, double leverArm, const Eigen::Vector3d& normal,
                 const LinearContact& contact);
 
 // Largest modulus of the eigenvalues of one velocity Verlet step of `model`.
@@ -76,6 +77,9 @@ double capillaryContactForceBound(double radius1, double radius2, const Capillar
 // bed, pressed by capillary bridges into six of the largest particles
 // (neighbourRadius, neighbourMaterial) around it: each contact carries the
 // capillary force at contact, compressed to the Hertz overlap of that force.
+// The neighbours move too: each contact's springs and dashpots are scaled by
+// 1 + m/m_neighbour, exact for two bodies moving against each other (2 for
+// equal spheres, ~1 for a small grain among large ones).
 // `props` is the interaction of the two materials, `rolling` the run's model.
 double capillaryClusterStableTimeStep(double radius, const Material& material, double neighbourRadius,
                                       const Material& neighbourMaterial, const InteractionProperties& props,

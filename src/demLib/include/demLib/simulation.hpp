@@ -1,8 +1,8 @@
 #pragma once
-#include <algorithm>
 // The DEM engine's front door: configuration structs in, state and fields out.
 // A Simulation owns the particles, the walls, the contact lists and the force
 // kernel, and advances them with velocity Verlet.
+#include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <memory>
