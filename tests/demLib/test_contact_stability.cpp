@@ -143,6 +143,60 @@ TEST(ContactStability, RollingSpringLowersTheWetLimit) {
     EXPECT_LT(limit(dem::RollingModel::EPSD2), 0.99 * limit(dem::RollingModel::CDT));
 }
 
+// Spheres of radius R around one of radius r = ratio R: 12 for equal ones
+// (fcc, icosahedron), 6 in an octahedral hole (ratio sqrt 2 - 1), 4 in a
+// tetrahedral one (sqrt(3/2) - 1), and the Tammes counts in between.
+TEST(ContactStability, ContactNumberAroundASphere) {
+    EXPECT_EQ(dem::contactNumberAround(1.0), 12);
+    EXPECT_EQ(dem::contactNumberAround(0.91), 12);
+    EXPECT_EQ(dem::contactNumberAround(0.89), 10);
+    EXPECT_EQ(dem::contactNumberAround(0.7), 8);
+    EXPECT_EQ(dem::contactNumberAround(std::sqrt(2.0) - 1.0 + 1e-6), 6);
+    EXPECT_EQ(dem::contactNumberAround(std::sqrt(1.5) - 1.0 + 1e-6), 4);
+    EXPECT_EQ(dem::contactNumberAround(0.18), 3);
+    // Twelve around an equal sphere touch it without overlapping each other:
+    // the icosahedron's neighbouring vertices are 63.43 deg apart, more than
+    // the 60 deg that two touching equal spheres subtend.
+    EXPECT_GT(std::acos(1.0 / std::sqrt(5.0)), 2.0 * std::asin(0.5));
+}
+
+// The wet-bed cluster of a grain among equal ones: twelve contacts in an
+// icosahedron act as the six of the cube with springs and dashpots doubled
+// (both arrangements have sum n n^T = N/3 I and sum n = 0).
+TEST(ContactStability, TwelveContactsActAsSixDoubled) {
+    const dem::Material sand{"sand", 5e6, 0.3, 2650.0};
+    dem::PairCoefficients c;
+    c.restitution = 0.1;
+    c.friction = 0.7;
+    c.rollingFriction = 0.5;
+    const dem::InteractionTable table = tableFor({sand}, c);
+    const double r = 0.6e-3, m = 2650.0 * 4.0 / 3.0 * kPi * r * r * r, overlap = 0.02 * r;
+    for (dem::RollingModel rolling : {dem::RollingModel::CDT, dem::RollingModel::EPSD2}) {
+        dem::LinearContact contact = dem::linearHertzContact(table(0, 0), 0.5 * r, 0.5 * m, overlap, rolling);
+        dem::ContactClusterModel icosahedron;
+        icosahedron.mass.diagonal() << m, m, m, 0.4 * m * r * r, 0.4 * m * r * r, 0.4 * m * r * r;
+        const double phi = 0.5 * (1.0 + std::sqrt(5.0));
+        for (double a : {1.0, -1.0})
+            for (double b : {phi, -phi}) {
+                dem::addContact(icosahedron, r - 0.5 * overlap, Eigen::Vector3d(0, a, b), contact);
+                dem::addContact(icosahedron, r - 0.5 * overlap, Eigen::Vector3d(a, b, 0), contact);
+                dem::addContact(icosahedron, r - 0.5 * overlap, Eigen::Vector3d(b, 0, a), contact);
+            }
+        for (double* part : {&contact.normalStiffness, &contact.tangentialStiffness, &contact.normalDamping,
+                             &contact.tangentialDamping, &contact.rollingStiffness, &contact.rollingDamping})
+            *part *= 2.0;
+        const double cube = dem::verletStableTimeStep(dem::cubicContactCluster(r, m, contact, r - 0.5 * overlap));
+        EXPECT_NEAR(dem::verletStableTimeStep(icosahedron) / cube, 1.0, 1e-6) << static_cast<int>(rolling);
+    }
+    // The engine's limit for equal grains counts twelve neighbours: 1/sqrt(2)
+    // of six's without damping; with it, a little less (the doubled dashpots
+    // damp harder).  Measured on a settled monodisperse wet bed: docs/engine.md.
+    const double equal = dem::capillaryClusterStableTimeStep(r, sand, r, sand, table(0, 0), dem::CapillaryParameters{}, 25.0);
+    const double nearlyEqual =
+        dem::capillaryClusterStableTimeStep(r, sand, r / 0.89, sand, table(0, 0), dem::CapillaryParameters{}, 25.0);
+    EXPECT_LT(equal, nearlyEqual);
+}
+
 // Eq 1 at contact: pi gamma sqrt(R1 R2) (exp(B) + C), largest at the smallest
 // reduced volume sampled (1e-5) for theta = 0.
 TEST(ContactStability, CapillaryContactForceBoundIsEq1AtTheSmallestVolume) {
@@ -163,7 +217,7 @@ dem::SimulationSettings wetSettings(double dt, double forceScale) {
     return s;
 }
 
-// The limit of a wet bed: six of the largest grains around the smallest,
+// The limit of a wet bed: six of the largest grains around the smallest (F32: ratio 0.18),
 // pressed by the coarse-grained capillary force.  A stronger force (coarse
 // grain l^k) presses harder: a smaller limit.  The engine refuses a step above
 // it, naming the keyword, and takes one below.

@@ -111,6 +111,20 @@ double verletStableTimeStep(const ContactClusterModel& model) {
     return low;
 }
 
+int contactNumberAround(double ratio) {
+    // Smallest ratio at which N spheres fit: 1 / sin(d_N / 2) - 1, d_N the
+    // largest smallest angular distance of N points on a sphere (Tammes;
+    // N = 11 fits no sooner than 12).
+    static constexpr struct {
+        double ratio;
+        int count;
+    } fits[] = {{0.9021, 12}, {0.8325, 10}, {0.7321, 9}, {0.6455, 8}, {0.5912, 7}, {0.4142, 6}, {0.2247, 4},
+                {0.1547, 3}};
+    for (const auto& f : fits)
+        if (ratio >= f.ratio) return f.count;
+    return 2;
+}
+
 double capillaryContactForceBound(double radius1, double radius2, const CapillaryParameters& capillary,
                                   double forceScale) {
     const double larger = std::max(radius1, radius2);
@@ -137,10 +151,12 @@ double capillaryClusterStableTimeStep(double radius, const Material& material, d
     const double overlap = std::pow(force / (props.normalStiffnessFactor * std::sqrt(radiusEff)), 2.0 / 3.0);
     const double rollingInertia = rollingInertiaEff(mass, radius, neighbourMass, neighbourRadius);
     LinearContact contact = linearHertzContact(props, radiusEff, massEff, overlap, rolling, rollingInertia);
-    const double mobility = 1.0 + mass / neighbourMass;
+    // The neighbours' motion (1 + m/m_n) and their number (N/6 on each of the cube's six).
+    const double neighbours = std::max(6, contactNumberAround(radius / neighbourRadius));
+    const double scale = (1.0 + mass / neighbourMass) * neighbours / 6.0;
     for (double* part : {&contact.normalStiffness, &contact.tangentialStiffness, &contact.normalDamping,
                          &contact.tangentialDamping, &contact.rollingStiffness, &contact.rollingDamping})
-        *part *= mobility;
+        *part *= scale;
     return verletStableTimeStep(cubicContactCluster(radius, mass, contact, radius - 0.5 * overlap));
 }
 

@@ -36,7 +36,8 @@ void requireTimeStepBelow(const SimulationSettings& settings, const Simulation::
           << " m/s (keyword 'impactVelocity') allows " << limits.hertz << " s";
         if (std::isfinite(limits.capillary))
             s << ", " << settings.maxCapillaryClusterFraction << " x the stable step of the smallest particle "
-              << "pressed by capillary bridges into six of the largest (keyword 'maxCapillaryClusterFraction'; "
+              << "pressed by capillary bridges into the largest (twelve around an equal one, at least six; keyword "
+              << "'maxCapillaryClusterFraction'; "
               << "beyond it a wet bed rattles) allows " << limits.capillary << " s";
         s << "; expected timeStep <= " << allowed
           << " (or set 'allowLargeTimeStep true' to override, at your own risk)";

@@ -9,10 +9,10 @@
 // they assume a packing.  This analysis needs a bed (e.g. a restart file of a
 // settled one) and assumes nothing about it: measured on the wet beds of
 // docs/engine.md it predicts where they start to rattle (polydisperse F32 at
-// coarse grain 5: stable at 3.5e-6 s, growing at 4.2e-6 s, as measured;
-// a monodisperse bed: 5.8e-6 s against a measured onset between 5 and 6e-6 s,
-// where the cluster model says 1.02e-5 s).  Its cost grows with the bed
-// (a few seconds per thousand particles and trial step): a tool for a bed of
+// coarse grain 5: 3.98e-6 s, measured onset between 3.5 and 4.2e-6 s; a
+// monodisperse bed: 5.75e-6 s, measured onset between 5 and 6e-6 s, where the
+// cluster model with six neighbours said 1.02e-5 s).  Its cost grows with the
+// bed (about 2 s per thousand particles and trial step): a tool for a bed of
 // some thousand particles (demStability), not a check inside a run.
 #include <cstddef>
 #include <vector>

@@ -66,6 +66,12 @@ double verletSpectralRadius(const ContactClusterModel& model, double dt);
 // to a relative 1e-9; infinity for a model without stiffness.
 double verletStableTimeStep(const ContactClusterModel& model);
 
+// How many spheres of radius R fit around one of radius r = ratio R, all
+// touching it (the Tammes problem: N caps of angular radius
+// asin(1 / (1 + ratio)) on a sphere): 12 for ratio >= 0.902 (equal spheres),
+// 10, 9, 8, 7 down to ratio 0.591, then 6, 5, 4, 3 (0.414, 0.414, 0.225, 0.155).
+int contactNumberAround(double ratio);
+
 // The contact force eqs 1-5 (times `forceScale`, the coarse-grain factor l^k
 // of eq 9) give for a bridge between touching spheres of radii r1 and r2, at
 // the reduced volume V* = V/r2^3 in [1e-5, 1e-1] that gives the largest force
@@ -74,9 +80,16 @@ double capillaryContactForceBound(double radius1, double radius2, const Capillar
                                   double forceScale);
 
 // The stable time step of the smallest particle (radius, material) of a wet
-// bed, pressed by capillary bridges into six of the largest particles
+// bed, pressed by capillary bridges into N of the largest particles
 // (neighbourRadius, neighbourMaterial) around it: each contact carries the
 // capillary force at contact, compressed to the Hertz overlap of that force.
+// N = contactNumberAround(radius / neighbourRadius), but at least six: a
+// grain among equal ones has twelve neighbours (a wet monodisperse bed packs
+// with 9-12 contacts per grain), and the six of a small grain among large
+// ones stand for its contacts with the middle sizes (docs/engine.md).  The N
+// contacts act as the six along +-x, +-y, +-z with springs and dashpots
+// times N/6 (exact for twelve in an icosahedron: both arrangements have
+// sum n n^T = N/3 I and sum n = 0).
 // The neighbours move too: each contact's springs and dashpots are scaled by
 // 1 + m/m_neighbour, exact for two bodies moving against each other (2 for
 // equal spheres, ~1 for a small grain among large ones).

@@ -48,7 +48,7 @@ struct SimulationSettings {
     double impactVelocity = 1.0;  // [m/s], the largest speed expected in the run
     // ... and, with capillary cohesion, not exceed this fraction of the step at
     // which the explicit integration of the smallest particle, pressed by its
-    // bridges into six of the largest, turns unstable (contact_stability.hpp):
+    // bridges into the largest (as many as fit, at least six), turns unstable (contact_stability.hpp):
     // beyond it a wet bed at rest rattles.
     double maxCapillaryClusterFraction = 1.0;
     // Systems of at least this many particles are sorted in space now and then
