@@ -120,6 +120,25 @@ TEST(BedStability, TwoFreeSpheresMatchTheRelativeMotionModel) {
     EXPECT_TRUE(dem::analyseBedStability(sim, judge).stableAtRunStep);
 }
 
+// A region holding one of the two spheres: the other is held fixed, as a
+// wall, so the contact acts undoubled.
+TEST(BedStability, ParticlesOutsideTheRegionAreHeldFixed) {
+    const std::vector<dem::Material> mats = sand();
+    const dem::InteractionTable table = tableFor(mats);
+    const double r = 1e-3, m = 2500.0 * 4.0 / 3.0 * kPi * r * r * r, overlap = 2e-3 * r;
+    dem::Simulation sim(settings(1e-7, Vec3::Zero(), dem::RollingModel::CDT), mats, table, {});
+    sim.insert({{Vec3(-r + 0.5 * overlap, 0, 0), r}, {Vec3(r - 0.5 * overlap, 0, 0), r}}, 0, Vec3::Zero());
+    const dem::LinearContact law = dem::linearHertzContact(table(0, 0), 0.5 * r, 0.5 * m, overlap);
+    const double expected = dem::verletStableTimeStep(oneContact(r, m, law, overlap, Vec3::UnitX()));
+    dem::BedStabilityOptions o = fine();
+    o.regionUpper = Vec3(0, 1, 1);  // x <= 0: the first sphere only
+    const dem::BedStabilityReport report = dem::analyseBedStability(sim, o);
+    EXPECT_EQ(report.particles, 1u);
+    EXPECT_EQ(report.particleContacts, 0u);
+    EXPECT_EQ(report.fixedParticleContacts, 1u);
+    EXPECT_NEAR(report.stableTimeStep / expected, 1.0, 0.01) << "bed " << report.stableTimeStep << " model " << expected;
+}
+
 TEST(BedStability, ABedWithoutContactsHasNoLimit) {
     const std::vector<dem::Material> mats = sand();
     dem::Simulation sim(settings(1e-6, Vec3::Zero(), dem::RollingModel::CDT), mats, tableFor(mats), {});

@@ -43,7 +43,10 @@ TEST(ContactStability, OneDampedModeMatchesTheClosedForm) {
         model.stiffness.diagonal().setConstant(stiffness);
         model.damping.diagonal().setConstant(2.0 * zeta * w * mass);
         const double expected = 2.0 * (std::sqrt(1.0 + zeta * zeta) - zeta) / w;
-        EXPECT_NEAR(dem::verletStableTimeStep(model), expected, 1e-6 * expected) << "zeta " << zeta;
+        // The bisection counts a mode as growing from a spectral radius of 1 + 1e-5
+        // (neutral modes come out of the eigensolver a few 1e-7 above 1): up to
+        // ~2e-6 beyond the bound.
+        EXPECT_NEAR(dem::verletStableTimeStep(model), expected, 1e-5 * expected) << "zeta " << zeta;
         EXPECT_LE(dem::verletSpectralRadius(model, 0.999 * expected), 1.0 + 1e-9);
         EXPECT_GT(dem::verletSpectralRadius(model, 1.001 * expected), 1.0 + 1e-7);
     }

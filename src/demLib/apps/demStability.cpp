@@ -3,7 +3,8 @@
 // settled bed), linearises every contact and reports the largest step at which
 // no mode of the bed grows, against the case's step and the a-priori limits
 // the engine checks at insertion.
-//   demStability [-case DIR] [-restart FILE|latest] [-timeStep T] [-iterations N] [-tolerance F] [-help]
+//   demStability [-case DIR] [-restart FILE|latest] [-timeStep T] [-region X0 Y0 Z0 X1 Y1 Z1]
+//                [-iterations N] [-tolerance F] [-help]
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -34,6 +35,8 @@ void usage(std::ostream& out) {
            "  -case DIR          case directory (default: current directory); reads DIR/constant/demProperties\n"
            "  -restart FILE      restart file of the bed; 'latest' (default) takes the newest one of the case\n"
            "  -timeStep T        the step to judge (default: the case's timeStep, which the restart file holds)\n"
+           "  -region X0 Y0 Z0 X1 Y1 Z1  only the particles with centres in this box [m] move; those outside\n"
+           "                     that touch them are held fixed (for a part of a large bed; default: all)\n"
            "  -iterations N      steps of the linear map per trial step (default 10000)\n"
            "  -tolerance F       relative tolerance of the bisection (default 0.01)\n"
            "  -help              this text\n\n"
@@ -77,6 +80,20 @@ int main(int argc, char** argv) {
                     throw dem::InputError("demStability: -iterations expects an integer in [100, 1e8], got '" +
                                           std::string(argv[i]) + "'");
                 options.iterations = static_cast<int>(n);
+            } else if (a == "-region") {
+                double v[6];
+                for (double& x : v) {
+                    const std::string text = value("six numbers: xmin ymin zmin xmax ymax zmax");
+                    char* end = nullptr;
+                    x = std::strtod(text.c_str(), &end);
+                    if (end == text.c_str() || *end != '\0' || !std::isfinite(x))
+                        throw dem::InputError("demStability: -region expects six numbers (xmin ymin zmin xmax ymax "
+                                              "zmax, m), got '" + text + "'");
+                }
+                if (!(v[0] < v[3] && v[1] < v[4] && v[2] < v[5]))
+                    throw dem::InputError("demStability: -region expects xmin < xmax, ymin < ymax, zmin < zmax");
+                options.regionLower = dem::Vec3(v[0], v[1], v[2]);
+                options.regionUpper = dem::Vec3(v[3], v[4], v[5]);
             } else if (a == "-tolerance") {
                 options.relativeTolerance = positiveNumber(a, value("a relative tolerance"));
                 if (options.relativeTolerance >= 0.5)
@@ -106,8 +123,10 @@ int main(int argc, char** argv) {
         std::cout << "demStability (demLib " << dem::versionString << "): " << restart << ", t = " << sim->time()
                   << " s\n";
         const dem::BedStabilityReport r = dem::analyseBedStability(*sim, options);
-        std::cout << std::setprecision(4) << r.particles << " particles, " << r.particleContacts
-                  << " particle contacts, " << r.wallContacts << " wall contacts; contacts per particle:";
+        std::cout << std::setprecision(4) << r.particles << " particles analysed (of " << sim->particles().size()
+                  << "), " << r.particleContacts << " contacts between them, " << r.fixedParticleContacts
+                  << " with particles held fixed outside the region, " << r.wallContacts
+                  << " with walls; contacts per particle:";
         for (std::size_t k = 0; k < r.contactsPerParticle.size(); ++k)
             if (r.contactsPerParticle[k] > 0) std::cout << ' ' << k << ':' << r.contactsPerParticle[k];
         std::cout << "\nundamped limit 2/w_max: " << r.undampedLimit << " s\n"

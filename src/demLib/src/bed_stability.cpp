@@ -25,14 +25,27 @@ struct LinearisedContact {
     double leverI = 0.0;
     double leverJ = 0.0;
     LinearContact law;
+    bool fixedParticle = false;  // j is a particle outside the region, held fixed
 };
 
-std::vector<LinearisedContact> bedContacts(const Simulation& sim) {
+// The contacts of the particles inside the region (their indices in
+// `inside`, which lists them); a particle outside it that touches one inside is
+// held fixed, as a wall.
+std::vector<LinearisedContact> bedContacts(const Simulation& sim, const BedStabilityOptions& options,
+                                           std::vector<int>& inside) {
     const ParticleStore& p = sim.particles();
     const int n = static_cast<int>(p.size());
     const RollingModel rolling = sim.settings().forces.rolling;
     std::vector<LinearisedContact> contacts;
-    if (n == 0) return contacts;
+    std::vector<int> local(p.size(), -1);  // particle -> its index among those inside
+    inside.clear();
+    for (int i = 0; i < n; ++i)
+        if ((p.position[i].array() >= options.regionLower.array()).all() &&
+            (p.position[i].array() <= options.regionUpper.array()).all()) {
+            local[i] = static_cast<int>(inside.size());
+            inside.push_back(i);
+        }
+    if (inside.empty()) return contacts;
     // Touching pairs from a grid of cells as wide as the largest diameter.
     const double cell = 2.0 * *std::max_element(p.radius.begin(), p.radius.end());
     // Cells packed into one integer, 21 bits per axis (2 million cells across).
@@ -53,7 +66,7 @@ std::vector<LinearisedContact> bedContacts(const Simulation& sim) {
         grid.emplace(key(static_cast<long>(c.x()), static_cast<long>(c.y()), static_cast<long>(c.z())), i);
     }
     std::vector<WallContact> found;
-    for (int i = 0; i < n; ++i) {
+    for (const int i : inside) {
         const Eigen::Array3d c = cellOf(p.position[i]);
         for (long dx = -1; dx <= 1; ++dx)
             for (long dy = -1; dy <= 1; ++dy)
@@ -63,7 +76,7 @@ std::vector<LinearisedContact> bedContacts(const Simulation& sim) {
                                                             static_cast<long>(c.z()) + dz));
                     for (auto it = range.first; it != range.second; ++it) {
                         const int j = it->second;
-                        if (j <= i) continue;
+                        if (j == i || (local[j] >= 0 && j < i)) continue;  // a pair inside once
                         const Vec3 d = p.position[j] - p.position[i];
                         const double dist = d.norm();
                         const double overlap = p.radius[i] + p.radius[j] - dist;
@@ -71,14 +84,15 @@ std::vector<LinearisedContact> bedContacts(const Simulation& sim) {
                         const double radiusEff = p.radius[i] * p.radius[j] / (p.radius[i] + p.radius[j]);
                         const double massEff = p.mass[i] * p.mass[j] / (p.mass[i] + p.mass[j]);
                         LinearisedContact k;
-                        k.i = i;
-                        k.j = j;
+                        k.i = local[i];
+                        k.j = local[j];  // -1 outside: held fixed
                         k.normal = d / dist;
                         k.leverI = p.radius[i] - 0.5 * overlap;
                         k.leverJ = p.radius[j] - 0.5 * overlap;
                         k.law = linearHertzContact(sim.interactions()(p.material[i], p.material[j]), radiusEff,
                                                    massEff, overlap, rolling,
                                                    rollingInertiaEff(p.mass[i], p.radius[i], p.mass[j], p.radius[j]));
+                        k.fixedParticle = local[j] < 0;
                         contacts.push_back(k);
                     }
                 }
@@ -88,7 +102,7 @@ std::vector<LinearisedContact> bedContacts(const Simulation& sim) {
             for (const WallContact& c : found) {
                 if (!(c.overlap > 0.0)) continue;
                 LinearisedContact k;
-                k.i = i;
+                k.i = local[i];
                 k.normal = -c.normal;  // the wall's normal points at the sphere
                 k.leverI = p.radius[i] - 0.5 * c.overlap;
                 k.law = linearHertzContact(sim.interactions()(p.material[i], w.materialIndex), p.radius[i],
@@ -157,15 +171,18 @@ void addContactForces(const std::vector<LinearisedContact>& contacts, const Eige
 BedStabilityReport analyseBedStability(const Simulation& sim, const BedStabilityOptions& options) {
     const ParticleStore& p = sim.particles();
     BedStabilityReport report;
-    report.particles = p.size();
     report.runTimeStep = options.timeStep > 0.0 ? options.timeStep : sim.timeStep();
-    const std::vector<LinearisedContact> contacts = bedContacts(sim);
-    std::vector<int> count(p.size(), 0);
+    std::vector<int> inside;
+    const std::vector<LinearisedContact> contacts = bedContacts(sim, options, inside);
+    report.particles = inside.size();
+    std::vector<int> count(inside.size(), 0);
     for (const LinearisedContact& q : contacts) {
         ++count[q.i];
         if (q.j >= 0) {
             ++count[q.j];
             ++report.particleContacts;
+        } else if (q.fixedParticle) {
+            ++report.fixedParticleContacts;
         } else {
             ++report.wallContacts;
         }
@@ -178,12 +195,13 @@ BedStabilityReport analyseBedStability(const Simulation& sim, const BedStability
         report.undampedLimit = report.stableTimeStep = std::numeric_limits<double>::infinity();
         return report;
     }
-    const Eigen::Index dof = 6 * static_cast<Eigen::Index>(p.size());
+    const Eigen::Index dof = 6 * static_cast<Eigen::Index>(inside.size());
     Eigen::VectorXd inverseMass(dof);
-    for (std::size_t i = 0; i < p.size(); ++i) {
+    for (std::size_t k = 0; k < inside.size(); ++k) {
+        const int i = inside[k];
         const double inertia = 0.4 * p.mass[i] * p.radius[i] * p.radius[i];
-        inverseMass.segment<3>(6 * i).setConstant(1.0 / p.mass[i]);
-        inverseMass.segment<3>(6 * i + 3).setConstant(1.0 / inertia);
+        inverseMass.segment<3>(6 * k).setConstant(1.0 / p.mass[i]);
+        inverseMass.segment<3>(6 * k + 3).setConstant(1.0 / inertia);
     }
     const Eigen::VectorXd still = Eigen::VectorXd::Zero(dof);
     Eigen::VectorXd force(dof);

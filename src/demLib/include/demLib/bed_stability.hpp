@@ -15,7 +15,10 @@
 // bed (about 2 s per thousand particles and trial step): a tool for a bed of
 // some thousand particles (demStability), not a check inside a run.
 #include <cstddef>
+#include <limits>
 #include <vector>
+
+#include "demLib/vec3.hpp"
 
 namespace dem {
 
@@ -26,11 +29,16 @@ struct BedStabilityOptions {
     double relativeTolerance = 0.01;   // of the bisection on the time step
     unsigned seed = 1;                 // of the random start
     double timeStep = 0.0;             // the step to judge [s] (0: the simulation's)
+    // Only the particles with centres in this box move; those outside that
+    // touch them are held fixed, as walls (default: the whole bed).
+    Vec3 regionLower = Vec3::Constant(-std::numeric_limits<double>::infinity());
+    Vec3 regionUpper = Vec3::Constant(std::numeric_limits<double>::infinity());
 };
 
 struct BedStabilityReport {
-    std::size_t particles = 0;
-    std::size_t particleContacts = 0;  // touching particle pairs
+    std::size_t particles = 0;         // that move (those in the region)
+    std::size_t particleContacts = 0;  // touching pairs of them
+    std::size_t fixedParticleContacts = 0;  // with particles outside the region
     std::size_t wallContacts = 0;
     // contactsPerParticle[k]: particles with k contacts (walls included).
     std::vector<std::size_t> contactsPerParticle;

@@ -62,7 +62,7 @@ void addContact(ContactClusterModel& model, double leverArm, const Eigen::Vector
 double verletSpectralRadius(const ContactClusterModel& model, double dt);
 
 // The largest dt for which no mode of `model` grows (spectral radius <= 1 +
-// 1e-7, so that the neutral modes of an unconstrained direction do not count),
+// 1e-5, so that the neutral modes of an unconstrained direction do not count),
 // to a relative 1e-9; infinity for a model without stiffness.
 double verletStableTimeStep(const ContactClusterModel& model);
 
