@@ -5,6 +5,7 @@
 // the engine checks at insertion.
 //   demStability [-case DIR] [-restart FILE|latest] [-timeStep T] [-region X0 Y0 Z0 X1 Y1 Z1]
 //                [-iterations N] [-tolerance F] [-help]
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -121,7 +122,17 @@ int main(int argc, char** argv) {
         const dem::Simulation::TimeStepLimits limits = sim->timeStepLimits();
 
         std::cout << "demStability (demLib " << dem::versionString << "): " << restart << ", t = " << sim->time()
-                  << " s\n";
+                  << " s" << std::endl;
+        // A progress line per trial step, with the time left (a trial costs about 2 s per
+        // thousand particles).
+        const auto start = std::chrono::steady_clock::now();
+        options.onTrial = [&](int trial, int expected, double dt, double growth, bool grows) {
+            const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            std::cout << "  trial " << trial << " of about " << expected << ": dt " << std::setprecision(4) << dt
+                      << " s " << (grows ? "grows" : "stable") << " (log growth per step " << growth
+                      << "), elapsed " << std::lround(elapsed) << " s, about "
+                      << std::lround(elapsed / trial * std::max(0, expected - trial)) << " s left" << std::endl;
+        };
         const dem::BedStabilityReport r = dem::analyseBedStability(*sim, options);
         std::cout << std::setprecision(4) << r.particles << " particles analysed (of " << sim->particles().size()
                   << "), " << r.particleContacts << " contacts between them, " << r.fixedParticleContacts

@@ -15,6 +15,7 @@
 // bed (about 2 s per thousand particles and trial step): a tool for a bed of
 // some thousand particles (demStability), not a check inside a run.
 #include <cstddef>
+#include <functional>
 #include <limits>
 #include <vector>
 
@@ -33,6 +34,10 @@ struct BedStabilityOptions {
     // touch them are held fixed, as walls (default: the whole bed).
     Vec3 regionLower = Vec3::Constant(-std::numeric_limits<double>::infinity());
     Vec3 regionUpper = Vec3::Constant(std::numeric_limits<double>::infinity());
+    // Called after each trial step (e.g. for progress lines): the trial's
+    // number (from 1), the number of trials expected in all, its step, its log
+    // growth per step and whether a mode grew.
+    std::function<void(int trial, int expectedTrials, double dt, double growth, bool grows)> onTrial;
 };
 
 struct BedStabilityReport {
