@@ -145,7 +145,10 @@ int main(int argc, char** argv) {
                   << options.relativeTolerance << ")\n"
                   << "a-priori limits of the engine: Rayleigh " << limits.rayleigh << " s, Hertz " << limits.hertz
                   << " s";
-        if (std::isfinite(limits.capillary)) std::cout << ", wet-bed cluster " << limits.capillary << " s";
+        if (std::isfinite(limits.capillary))
+            std::cout << ", wet-bed cluster " << limits.capillary << " s (" << sim->settings().maxCapillaryClusterFraction
+                      << " x the cluster model's " << limits.capillary / sim->settings().maxCapillaryClusterFraction
+                      << " s)";
         std::cout << "\ntime step " << r.runTimeStep << " s: "
                   << (r.stableAtRunStep ? "stable" : "a mode grows") << " (log growth per step "
                   << r.growthAtRunStep << "), " << r.runTimeStep / r.stableTimeStep << " of the bed's stable step"
