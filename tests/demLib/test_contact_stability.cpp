@@ -157,6 +157,25 @@ TEST(ContactStability, ContactNumberAroundASphere) {
     EXPECT_EQ(dem::contactNumberAround(std::sqrt(2.0) - 1.0 + 1e-6), 6);
     EXPECT_EQ(dem::contactNumberAround(std::sqrt(1.5) - 1.0 + 1e-6), 4);
     EXPECT_EQ(dem::contactNumberAround(0.18), 3);
+    EXPECT_EQ(dem::contactNumberAround(0.8), 9);
+    EXPECT_EQ(dem::contactNumberAround(0.6), 7);
+    // Each threshold 1 / sin(d_N / 2) - 1 from the Tammes separations d_N [deg]: N fits just
+    // above it, not just below (N = 11 needs as much room as 12, N = 5 as 6).
+    const double deg = kPi / 180.0;
+    const std::vector<std::pair<int, double>> tammes{{12, 63.4349}, {10, 66.1468}, {9, 70.5288}, {8, 74.8585},
+                                                     {7, 77.8695}, {6, 90.0}, {4, 109.4712}, {3, 120.0}};
+    int below = 0;
+    for (const auto& [count, separation] : tammes) {
+        const double threshold = 1.0 / std::sin(0.5 * separation * deg) - 1.0;
+        // (the table holds the thresholds rounded up to 1e-6)
+        EXPECT_EQ(dem::contactNumberAround(threshold * (1.0 + 1e-5)), count) << count;
+        const int next = dem::contactNumberAround(threshold * (1.0 - 1e-5));
+        EXPECT_LT(next, count) << count;
+        if (below > 0) {
+            EXPECT_EQ(below, count) << "the count below the previous threshold";
+        }
+        below = next;
+    }
     // Twelve around an equal sphere touch it without overlapping each other:
     // the icosahedron's neighbouring vertices are 63.43 deg apart, more than
     // the 60 deg that two touching equal spheres subtend.
@@ -194,10 +213,15 @@ TEST(ContactStability, TwelveContactsActAsSixDoubled) {
     // The engine's limit for equal grains counts twelve neighbours: 1/sqrt(2)
     // of six's without damping; with it, a little less (the doubled dashpots
     // damp harder).  Measured on a settled monodisperse wet bed: docs/engine.md.
-    const double equal = dem::capillaryClusterStableTimeStep(r, sand, r, sand, table(0, 0), dem::CapillaryParameters{}, 25.0);
-    const double nearlyEqual =
-        dem::capillaryClusterStableTimeStep(r, sand, r / 0.89, sand, table(0, 0), dem::CapillaryParameters{}, 25.0);
-    EXPECT_LT(equal, nearlyEqual);
+    const dem::CapillaryParameters water{};
+    const auto cluster = [&](double neighbourRadius, int count) {
+        return dem::capillaryClusterStableTimeStep(r, sand, neighbourRadius, sand, table(0, 0), water, 25.0,
+                                                   dem::RollingModel::CDT, count);
+    };
+    EXPECT_DOUBLE_EQ(cluster(r, 0), cluster(r, 12));             // equal grains: twelve
+    EXPECT_LT(cluster(r, 12), 0.75 * cluster(r, 6));              // measured 0.52 here
+    EXPECT_DOUBLE_EQ(cluster(r / 0.8, 0), cluster(r / 0.8, 9));  // ratio 0.8: nine
+    EXPECT_DOUBLE_EQ(cluster(r / 0.18, 0), cluster(r / 0.18, 6));  // F32's 0.18 would fit 3: six at least
 }
 
 // Eq 1 at contact: pi gamma sqrt(R1 R2) (exp(B) + C), largest at the smallest

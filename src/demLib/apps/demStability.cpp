@@ -38,8 +38,8 @@ void usage(std::ostream& out) {
            "  -timeStep T        the step to judge (default: the case's timeStep, which the restart file holds)\n"
            "  -region X0 Y0 Z0 X1 Y1 Z1  only the particles with centres in this box [m] move; those outside\n"
            "                     that touch them are held fixed (for a part of a large bed; default: all)\n"
-           "  -iterations N      steps of the linear map per trial step (default 10000)\n"
-           "  -tolerance F       relative tolerance of the bisection (default 0.01)\n"
+           "  -iterations N      steps of the linear map per trial step (default 10000, at least 1000)\n"
+           "  -tolerance F       relative tolerance of the bisection (default 0.01, in [1e-6, 0.5))\n"
            "  -help              this text\n\n"
            "Exit status: 0 when the step is stable, 3 when a mode grows at it, 1 on bad input, 2 on a\n"
            "runtime failure.\n";
@@ -71,14 +71,19 @@ int main(int argc, char** argv) {
                 return 0;
             } else if (a == "-case") {
                 caseDir = value("a directory");
+                if (caseDir.rfind('-', 0) == 0)
+                    throw dem::InputError("demStability: -case expects a directory, got the option '" + caseDir + "'");
             } else if (a == "-restart") {
                 restart = value("a restart file or 'latest'");
+                if (restart.rfind('-', 0) == 0)
+                    throw dem::InputError("demStability: -restart expects a restart file or 'latest', got the option '" +
+                                          restart + "'");
             } else if (a == "-timeStep") {
                 options.timeStep = positiveNumber(a, value("a time step in seconds"));
             } else if (a == "-iterations") {
                 const double n = positiveNumber(a, value("a number of steps"));
-                if (n < 100 || n > 1e8 || n != std::floor(n))
-                    throw dem::InputError("demStability: -iterations expects an integer in [100, 1e8], got '" +
+                if (n < 1000 || n > 1e8 || n != std::floor(n))
+                    throw dem::InputError("demStability: -iterations expects an integer in [1000, 1e8], got '" +
                                           std::string(argv[i]) + "'");
                 options.iterations = static_cast<int>(n);
             } else if (a == "-region") {
@@ -97,8 +102,8 @@ int main(int argc, char** argv) {
                 options.regionUpper = dem::Vec3(v[3], v[4], v[5]);
             } else if (a == "-tolerance") {
                 options.relativeTolerance = positiveNumber(a, value("a relative tolerance"));
-                if (options.relativeTolerance >= 0.5)
-                    throw dem::InputError("demStability: -tolerance expects a number in (0, 0.5), got '" +
+                if (options.relativeTolerance < 1e-6 || options.relativeTolerance >= 0.5)
+                    throw dem::InputError("demStability: -tolerance expects a number in [1e-6, 0.5), got '" +
                                           std::string(argv[i]) + "'");
             } else {
                 usage(std::cerr);
@@ -133,6 +138,15 @@ int main(int argc, char** argv) {
                       << "), elapsed " << std::lround(elapsed) << " s, about "
                       << std::lround(elapsed / trial * std::max(0, expected - trial)) << " s left" << std::endl;
         };
+        if (options.regionLower.allFinite() || options.regionUpper.allFinite()) {
+            std::size_t inRegion = 0;
+            for (const dem::Vec3& x : sim->particles().position)
+                inRegion += (x.array() >= options.regionLower.array()).all() &&
+                            (x.array() <= options.regionUpper.array()).all();
+            if (inRegion == 0)
+                throw dem::InputError("demStability: -region holds no particle centre of the bed (expected a box "
+                                      "around some of its " + std::to_string(sim->particles().size()) + " particles)");
+        }
         const dem::BedStabilityReport r = dem::analyseBedStability(*sim, options);
         std::cout << std::setprecision(4) << r.particles << " particles analysed (of " << sim->particles().size()
                   << "), " << r.particleContacts << " contacts between them, " << r.fixedParticleContacts

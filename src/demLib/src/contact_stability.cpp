@@ -122,8 +122,8 @@ int contactNumberAround(double ratio) {
     static constexpr struct {
         double ratio;
         int count;
-    } fits[] = {{0.9021, 12}, {0.8325, 10}, {0.7321, 9}, {0.6455, 8}, {0.5912, 7}, {0.4142, 6}, {0.2247, 4},
-                {0.1547, 3}};
+    } fits[] = {{0.902114, 12}, {0.832466, 10}, {0.732051, 9}, {0.645330, 8}, {0.591255, 7}, {0.414214, 6},
+                {0.224745, 4}, {0.154701, 3}};  // rounded up
     for (const auto& f : fits)
         if (ratio >= f.ratio) return f.count;
     return 2;
@@ -144,7 +144,7 @@ double capillaryContactForceBound(double radius1, double radius2, const Capillar
 double capillaryClusterStableTimeStep(double radius, const Material& material, double neighbourRadius,
                                       const Material& neighbourMaterial, const InteractionProperties& props,
                                       const CapillaryParameters& capillary, double forceScale,
-                                      RollingModel rolling) {
+                                      RollingModel rolling, int neighbourCount) {
     const double mass = sphereMass(radius, material.density);
     const double neighbourMass = sphereMass(neighbourRadius, neighbourMaterial.density);
     const double radiusEff = radius * neighbourRadius / (radius + neighbourRadius);
@@ -156,7 +156,8 @@ double capillaryClusterStableTimeStep(double radius, const Material& material, d
     const double rollingInertia = rollingInertiaEff(mass, radius, neighbourMass, neighbourRadius);
     LinearContact contact = linearHertzContact(props, radiusEff, massEff, overlap, rolling, rollingInertia);
     // The neighbours' motion (1 + m/m_n) and their number (N/6 on each of the cube's six).
-    const double neighbours = std::max(6, contactNumberAround(radius / neighbourRadius));
+    const double neighbours =
+        neighbourCount > 0 ? neighbourCount : std::max(6, contactNumberAround(radius / neighbourRadius));
     const double scale = (1.0 + mass / neighbourMass) * neighbours / 6.0;
     for (double* part : {&contact.normalStiffness, &contact.tangentialStiffness, &contact.normalDamping,
                          &contact.tangentialDamping, &contact.rollingStiffness, &contact.rollingDamping})

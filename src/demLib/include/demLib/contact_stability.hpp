@@ -69,7 +69,8 @@ double verletStableTimeStep(const ContactClusterModel& model);
 // How many spheres of radius R fit around one of radius r = ratio R, all
 // touching it (the Tammes problem: N caps of angular radius
 // asin(1 / (1 + ratio)) on a sphere): 12 for ratio >= 0.902 (equal spheres),
-// 10, 9, 8, 7 down to ratio 0.591, then 6, 5, 4, 3 (0.414, 0.414, 0.225, 0.155).
+// 10, 9, 8, 7 down to ratio 0.591, then 6 (from 0.414; 5 fits no sooner),
+// 4 (0.225), 3 (0.155), else 2.
 int contactNumberAround(double ratio);
 
 // The contact force eqs 1-5 (times `forceScale`, the coarse-grain factor l^k
@@ -88,8 +89,11 @@ double capillaryContactForceBound(double radius1, double radius2, const Capillar
 // with 9-12 contacts per grain), and the six of a small grain among large
 // ones stand for its contacts with the middle sizes (docs/engine.md).  The N
 // contacts act as the six along +-x, +-y, +-z with springs and dashpots
-// times N/6 (exact for twelve in an icosahedron: both arrangements have
-// sum n n^T = N/3 I and sum n = 0).
+// times N/6: exact for twelve in an icosahedron (both arrangements have
+// sum n n^T = N/3 I and sum n = 0), an isotropic approximation for 7-10,
+// whose closest packings are not isotropic (for eight, a square antiprism,
+// the step is 0.91 of the approximation's; the engine's default fraction 0.9
+// covers it).  neighbourCount > 0 sets N instead.
 // The neighbours move too: each contact's springs and dashpots are scaled by
 // 1 + m/m_neighbour, exact for two bodies moving against each other (2 for
 // equal spheres, ~1 for a small grain among large ones).
@@ -97,6 +101,6 @@ double capillaryContactForceBound(double radius1, double radius2, const Capillar
 double capillaryClusterStableTimeStep(double radius, const Material& material, double neighbourRadius,
                                       const Material& neighbourMaterial, const InteractionProperties& props,
                                       const CapillaryParameters& capillary, double forceScale,
-                                      RollingModel rolling = RollingModel::None);
+                                      RollingModel rolling = RollingModel::None, int neighbourCount = 0);
 
 }  // namespace dem
