@@ -35,6 +35,7 @@ long firstIndexAfter(double time, double interval) {
 CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream& log)
     : setup_(std::move(setup)), options_(options), log_(log) {
     simulation_ = makeSimulation(setup_);
+    wetted_ = !(setup_.wettingTime > 0.0);
     const fs::path out = outputDirectory();
     fs::create_directories(out / "restart");
 
@@ -48,6 +49,9 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
         simulation_->readRestart(restart);
         startTime_ = simulation_->time();
         readRunnerState(restart);
+        // Wetting happens after the step that reaches wettingTime and before that
+        // step's output, so a restart file at or after it holds the water.
+        wetted_ = wetted_ || setup_.wettingTime <= startTime_ + 1e-12;
         log_ << "Continuing from restart file " << restart << " at t = " << startTime_ << " s, step "
              << simulation_->stepCount() << ", " << simulation_->particles().size() << " particles\n";
     }
@@ -92,6 +96,7 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
 
     if (restart.empty()) {
         performDueInsertions();
+        performDueWetting();
         writeDueOutput(true);
     }
     wallStart_ = lastProgress_ = std::chrono::steady_clock::now();
@@ -134,7 +139,7 @@ void CaseRunner::performDueInsertions() {
         placed_ += n;
         log_ << "Inserted " << n << " particles (" << mass * 1e3 << " g) of '" << spec.name << "' at t = " << now
              << " s";
-        if (setup_.waterContent > 0.0 && n > 0) {
+        if (setup_.waterContent > 0.0 && n > 0 && wetted_) {
             // The water belongs to the dry mass now present: w m_dry of liquid,
             // shared out again at the next contact-list update.
             simulation_->setWaterContent(setup_.waterContent);
@@ -265,6 +270,19 @@ bool CaseRunner::insertionDueAt(double now) const {
     return !(placed_ > 0 && now < nextWaveTime_ - 1e-12);  // the last wave is still settling
 }
 
+bool CaseRunner::wettingDueAt(double now) const {
+    return !wetted_ && setup_.waterContent > 0.0 && setup_.wettingTime <= now + 1e-12;
+}
+
+void CaseRunner::performDueWetting() {
+    if (!wettingDueAt(simulation_->time())) return;
+    simulation_->setWaterContent(setup_.waterContent);
+    wetted_ = true;
+    log_ << "Wetted at t = " << simulation_->time() << " s (keyword 'wettingTime'): liquid "
+         << simulation_->liquid().totalVolume << " m^3 (w = " << setup_.waterContent << ") on "
+         << simulation_->particles().size() << " particles" << std::endl;
+}
+
 bool CaseRunner::outputDueAt(double t) const {
     const OutputSpec& o = setup_.output;
     return intervalDue(o.fieldInterval, nextField_, t) || intervalDue(o.logInterval, nextLog_, t) ||
@@ -286,10 +304,11 @@ void CaseRunner::advanceTo(double time) {
         for (long next = s.stepCount() + 1; steps < maxStepsPerCall; ++next) {
             ++steps;
             const double t = static_cast<double>(next) * dt;
-            if (!(t < target - 0.5 * dt) || insertionDueAt(t) || outputDueAt(t)) break;
+            if (!(t < target - 0.5 * dt) || insertionDueAt(t) || wettingDueAt(t) || outputDueAt(t)) break;
         }
         s.step(steps);
         performDueInsertions();
+        performDueWetting();
         writeDueOutput(false);
         progress(false);
     }

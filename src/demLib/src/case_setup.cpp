@@ -263,6 +263,7 @@ CaseSetup readCaseSetup(const Dictionary& root, const std::string& caseDir) {
         if (m == "capillary") {
             s.forces.cohesion = CohesionModel::Capillary;
             c.waterContent = coh.getInRange("waterContent", 0.0, 1.0);
+            if (coh.has("wettingTime")) c.wettingTime = coh.getInRange("wettingTime", 0.0, 1e9);
             s.forces.capillary.surfaceTension = coh.getOrDefault<double>("surfaceTension", 0.072);
             const double degrees = coh.getOrDefault<double>("contactAngle", 0.0);
             if (!(degrees >= 0.0 && degrees < 90.0)) invalid(coh, "contactAngle", "expected degrees in [0, 90)");

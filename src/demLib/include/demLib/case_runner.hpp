@@ -44,6 +44,8 @@ private:
     // Is output of this interval due at time t, the next one being number `next`?
     bool intervalDue(double interval, long next, double t) const;
     bool insertionDueAt(double time) const;  // would performDueInsertions insert at this time?
+    bool wettingDueAt(double time) const;    // is the water of a later wettingTime to be added now?
+    void performDueWetting();
     bool outputDueAt(double time) const;     // would writeDueOutput(false) write at this time?
     void performDueInsertions();
     void writeDueOutput(bool force);
@@ -60,6 +62,7 @@ private:
     std::unique_ptr<FieldOutput> fields_;
     std::ofstream summary_;
     std::size_t insertionsDone_ = 0;
+    bool wetted_ = false;  // the water was added (at once when wettingTime is 0)
     // The block being inserted in waves: its population and how much is placed.
     std::vector<double> population_;
     std::size_t placed_ = 0;

@@ -59,6 +59,11 @@ struct CaseSetup {
     OutputSpec output;
     double endTime = 0.0;
     double waterContent = 0.0;  // > 0 with the capillary model
+    // The water is added at this time [s] (0: with the particles, each insertion
+    // wetted as it comes): the paper fills its shoe dry and then conditions the
+    // bed with humid air, so that bridges form in a poured frictional packing
+    // (docs/capillary-model.md, liquid coordination).
+    double wettingTime = 0.0;
     CoarseGrainSettings coarseGrain;
 
     int materialIndex(const std::string& name) const;  // -1 if unknown
