@@ -58,6 +58,15 @@ dem::ContactClusterModel oneContact(double r, double m, const dem::LinearContact
     return model;
 }
 
+// The spheres of these tests: 1 mm of sand (density 2500).
+constexpr double kRadius = 1e-3;
+const double kMass = 2500.0 * 4.0 / 3.0 * kPi * kRadius * kRadius * kRadius;
+
+// Two free spheres of radius r along x, touching with `overlap`.
+void insertTouchingPair(dem::Simulation& sim, double r, double overlap) {
+    sim.insert({{Vec3(-r + 0.5 * overlap, 0, 0), r}, {Vec3(r - 0.5 * overlap, 0, 0), r}}, 0, Vec3::Zero());
+}
+
 dem::BedStabilityOptions fine() {
     dem::BedStabilityOptions o;
     o.relativeTolerance = 0.002;
@@ -67,7 +76,7 @@ dem::BedStabilityOptions fine() {
 TEST(BedStability, SphereOnAFloorMatchesTheOneParticleModel) {
     const std::vector<dem::Material> mats = sand();
     const dem::InteractionTable table = tableFor(mats);
-    const double r = 1e-3, m = 2500.0 * 4.0 / 3.0 * kPi * r * r * r;
+    const double r = kRadius, m = kMass;
     // EPSD: the rolling spring and dashpot of the wall contact count too.
     dem::Simulation sim(settings(1e-6, Vec3(0, 0, -9.81), dem::RollingModel::EPSD), mats, table,
                         {dem::Wall{"floor", dem::PlaneWall(Vec3::Zero(), Vec3::UnitZ()), dem::WallMotion(), 0}});
@@ -91,11 +100,11 @@ TEST(BedStability, SphereOnAFloorMatchesTheOneParticleModel) {
 TEST(BedStability, TwoFreeSpheresMatchTheRelativeMotionModel) {
     const std::vector<dem::Material> mats = sand();
     const dem::InteractionTable table = tableFor(mats);
-    const double r = 1e-3, m = 2500.0 * 4.0 / 3.0 * kPi * r * r * r, overlap = 2e-3 * r;
+    const double r = kRadius, m = kMass, overlap = 2e-3 * r;
     // CDT: no rolling spring (the rolling mode of two spheres is not the slip
     // mode, so the doubled one-particle model is exact only without it).
     dem::Simulation sim(settings(1e-7, Vec3::Zero(), dem::RollingModel::CDT), mats, table, {});
-    sim.insert({{Vec3(-r + 0.5 * overlap, 0, 0), r}, {Vec3(r - 0.5 * overlap, 0, 0), r}}, 0, Vec3::Zero());
+    insertTouchingPair(sim, r, overlap);
     dem::LinearContact law = dem::linearHertzContact(table(0, 0), 0.5 * r, 0.5 * m, overlap);
     for (double* part : {&law.normalStiffness, &law.tangentialStiffness, &law.normalDamping, &law.tangentialDamping})
         *part *= 2.0;
@@ -125,9 +134,9 @@ TEST(BedStability, TwoFreeSpheresMatchTheRelativeMotionModel) {
 TEST(BedStability, ParticlesOutsideTheRegionAreHeldFixed) {
     const std::vector<dem::Material> mats = sand();
     const dem::InteractionTable table = tableFor(mats);
-    const double r = 1e-3, m = 2500.0 * 4.0 / 3.0 * kPi * r * r * r, overlap = 2e-3 * r;
+    const double r = kRadius, m = kMass, overlap = 2e-3 * r;
     dem::Simulation sim(settings(1e-7, Vec3::Zero(), dem::RollingModel::CDT), mats, table, {});
-    sim.insert({{Vec3(-r + 0.5 * overlap, 0, 0), r}, {Vec3(r - 0.5 * overlap, 0, 0), r}}, 0, Vec3::Zero());
+    insertTouchingPair(sim, r, overlap);
     const dem::LinearContact law = dem::linearHertzContact(table(0, 0), 0.5 * r, 0.5 * m, overlap);
     const double expected = dem::verletStableTimeStep(oneContact(r, m, law, overlap, Vec3::UnitX()));
     dem::BedStabilityOptions o = fine();

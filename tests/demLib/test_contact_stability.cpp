@@ -130,13 +130,20 @@ TEST(ContactStability, EngineTurnsUnstableWhereTheModelSays) {
     }
 }
 
-// EPSD2's rolling spring stiffens the spin modes: a lower limit than CDT's.
-TEST(ContactStability, RollingSpringLowersTheWetLimit) {
-    const dem::Material sand{"sand", 5e6, 0.3, 2650.0};
+// The paper's sand (Table 3) and its sand-sand coefficients (Table 2).
+dem::Material paperSand() { return {"sand", 5e6, 0.3, 2650.0}; }
+dem::PairCoefficients paperSandPair() {
     dem::PairCoefficients c;
     c.restitution = 0.1;
     c.friction = 0.7;
     c.rollingFriction = 0.5;
+    return c;
+}
+
+// EPSD2's rolling spring stiffens the spin modes: a lower limit than CDT's.
+TEST(ContactStability, RollingSpringLowersTheWetLimit) {
+    const dem::Material sand = paperSand();
+    const dem::PairCoefficients c = paperSandPair();
     const dem::InteractionProperties props = dem::makeInteraction(sand, sand, c);
     const double scale = std::pow(5.0, 2.0142);
     auto limit = [&](dem::RollingModel rolling) {
@@ -186,11 +193,8 @@ TEST(ContactStability, ContactNumberAroundASphere) {
 // icosahedron act as the six of the cube with springs and dashpots doubled
 // (both arrangements have sum n n^T = N/3 I and sum n = 0).
 TEST(ContactStability, TwelveContactsActAsSixDoubled) {
-    const dem::Material sand{"sand", 5e6, 0.3, 2650.0};
-    dem::PairCoefficients c;
-    c.restitution = 0.1;
-    c.friction = 0.7;
-    c.rollingFriction = 0.5;
+    const dem::Material sand = paperSand();
+    const dem::PairCoefficients c = paperSandPair();
     const dem::InteractionTable table = tableFor({sand}, c);
     const double r = 0.6e-3, m = 2650.0 * 4.0 / 3.0 * kPi * r * r * r, overlap = 0.02 * r;
     for (dem::RollingModel rolling : {dem::RollingModel::CDT, dem::RollingModel::EPSD2}) {

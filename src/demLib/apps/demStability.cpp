@@ -9,12 +9,12 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <string>
 
 #include "demLib/bed_stability.hpp"
+#include "demLib/case_runner.hpp"
 #include "demLib/case_setup.hpp"
 #include "demLib/error.hpp"
 #include "demLib/simulation.hpp"
@@ -45,11 +45,18 @@ void usage(std::ostream& out) {
            "runtime failure.\n";
 }
 
-double positiveNumber(const std::string& option, const std::string& text) {
+// A finite number, or an InputError naming the option and what it expects.
+double number(const std::string& option, const std::string& text, const std::string& expected) {
     char* end = nullptr;
     const double v = std::strtod(text.c_str(), &end);
-    if (end == text.c_str() || *end != '\0' || !(v > 0.0) || !std::isfinite(v))
-        throw dem::InputError("demStability: " + option + " expects a positive number, got '" + text + "'");
+    if (end == text.c_str() || *end != '\0' || !std::isfinite(v))
+        throw dem::InputError("demStability: " + option + " expects " + expected + ", got '" + text + "'");
+    return v;
+}
+
+double positiveNumber(const std::string& option, const std::string& text) {
+    const double v = number(option, text, "a positive number");
+    if (!(v > 0.0)) throw dem::InputError("demStability: " + option + " expects a positive number, got '" + text + "'");
     return v;
 }
 
@@ -88,14 +95,9 @@ int main(int argc, char** argv) {
                 options.iterations = static_cast<int>(n);
             } else if (a == "-region") {
                 double v[6];
-                for (double& x : v) {
-                    const std::string text = value("six numbers: xmin ymin zmin xmax ymax zmax");
-                    char* end = nullptr;
-                    x = std::strtod(text.c_str(), &end);
-                    if (end == text.c_str() || *end != '\0' || !std::isfinite(x))
-                        throw dem::InputError("demStability: -region expects six numbers (xmin ymin zmin xmax ymax "
-                                              "zmax, m), got '" + text + "'");
-                }
+                for (double& x : v)
+                    x = number(a, value("six numbers: xmin ymin zmin xmax ymax zmax"),
+                               "six numbers (xmin ymin zmin xmax ymax zmax, m)");
                 if (!(v[0] < v[3] && v[1] < v[4] && v[2] < v[5]))
                     throw dem::InputError("demStability: -region expects xmin < xmax, ymin < ymax, zmin < zmax");
                 options.regionLower = dem::Vec3(v[0], v[1], v[2]);
@@ -112,13 +114,11 @@ int main(int argc, char** argv) {
         }
         dem::CaseSetup setup = dem::readCaseSetup(caseDir);
         if (restart == "latest") {
-            const fs::path dir = fs::path(setup.caseDir) / setup.output.directory / "restart";
-            std::ifstream pointer(dir / "latest");
-            std::string name;
-            if (!(pointer >> name) || !fs::exists(dir / name))
-                throw dem::InputError("demStability: -restart latest: no restart file found in '" + dir.string() +
+            restart = dem::latestRestartFile(setup);
+            if (restart.empty())
+                throw dem::InputError("demStability: -restart latest: no restart file found in '" +
+                                      (fs::path(setup.caseDir) / setup.output.directory / "restart").string() +
                                       "' (run the case first, or give -restart FILE)");
-            restart = (dir / name).string();
         }
         // The bed is analysed, not run: the a-priori checks are reported below, not enforced.
         setup.settings.allowLargeTimeStep = true;
@@ -138,16 +138,10 @@ int main(int argc, char** argv) {
                       << "), elapsed " << std::lround(elapsed) << " s, about "
                       << std::lround(elapsed / trial * std::max(0, expected - trial)) << " s left" << std::endl;
         };
-        if (options.regionLower.allFinite() || options.regionUpper.allFinite()) {
-            std::size_t inRegion = 0;
-            for (const dem::Vec3& x : sim->particles().position)
-                inRegion += (x.array() >= options.regionLower.array()).all() &&
-                            (x.array() <= options.regionUpper.array()).all();
-            if (inRegion == 0)
-                throw dem::InputError("demStability: -region holds no particle centre of the bed (expected a box "
-                                      "around some of its " + std::to_string(sim->particles().size()) + " particles)");
-        }
         const dem::BedStabilityReport r = dem::analyseBedStability(*sim, options);
+        if (r.particles == 0 && !sim->particles().empty())
+            throw dem::InputError("demStability: -region holds no particle centre of the bed (expected a box "
+                                  "around some of its " + std::to_string(sim->particles().size()) + " particles)");
         std::cout << std::setprecision(4) << r.particles << " particles analysed (of " << sim->particles().size()
                   << "), " << r.particleContacts << " contacts between them, " << r.fixedParticleContacts
                   << " with particles held fixed outside the region, " << r.wallContacts

@@ -7,8 +7,8 @@
 #include <random>
 #include <stdexcept>
 #include <string>
-#include <unordered_map>
 
+#include "demLib/cell_bins.hpp"
 #include "demLib/contact_rolling_resistance.hpp"
 #include "demLib/contact_stability.hpp"
 #include "demLib/error.hpp"
@@ -48,36 +48,18 @@ std::vector<LinearisedContact> bedContacts(const Simulation& sim, const BedStabi
             inside.push_back(i);
         }
     if (inside.empty()) return contacts;
-    // Touching pairs from a grid of cells as wide as the largest diameter.
-    const double cell = 2.0 * *std::max_element(p.radius.begin(), p.radius.end());
-    // Cells packed into one integer, 21 bits per axis (2 million cells across).
-    auto key = [](long x, long y, long z) {
-        constexpr long offset = 1L << 20;
-        return ((x + offset) << 42) | ((y + offset) << 21) | (z + offset);
-    };
-    auto cellOf = [&](const Vec3& x) {
-        const Eigen::Array3d c(std::floor(x.x() / cell), std::floor(x.y() / cell), std::floor(x.z() / cell));
-        if (!(c.abs() < 1e6).all())
-            throw InputError("bed stability: a particle lies more than a million diameters from the origin");
-        return c;
-    };
-    std::unordered_multimap<long, int> grid;  // cell -> particles
-    grid.reserve(p.size());
-    for (int i = 0; i < n; ++i) {
-        const Eigen::Array3d c = cellOf(p.position[i]);
-        grid.emplace(key(static_cast<long>(c.x()), static_cast<long>(c.y()), static_cast<long>(c.z())), i);
-    }
+    // Touching pairs from cells at least as wide as the largest diameter.
+    const CellBins bins = binIntoCells(p.position, 2.0 * *std::max_element(p.radius.begin(), p.radius.end()));
     std::vector<WallContact> found;
     for (const int i : inside) {
-        const Eigen::Array3d c = cellOf(p.position[i]);
-        for (long dx = -1; dx <= 1; ++dx)
-            for (long dy = -1; dy <= 1; ++dy)
-                for (long dz = -1; dz <= 1; ++dz) {
-                    const auto range = grid.equal_range(key(static_cast<long>(c.x()) + dx,
-                                                            static_cast<long>(c.y()) + dy,
-                                                            static_cast<long>(c.z()) + dz));
-                    for (auto it = range.first; it != range.second; ++it) {
-                        const int j = it->second;
+        const int cell = bins.cellOf[i];
+        const int cx = cell % bins.nx, cy = (cell / bins.nx) % bins.ny, cz = cell / (bins.nx * bins.ny);
+        for (int z = std::max(cz - 1, 0); z <= std::min(cz + 1, bins.nz - 1); ++z)
+            for (int y = std::max(cy - 1, 0); y <= std::min(cy + 1, bins.ny - 1); ++y)
+                for (int x = std::max(cx - 1, 0); x <= std::min(cx + 1, bins.nx - 1); ++x) {
+                    const int neighbour = (z * bins.ny + y) * bins.nx + x;
+                    for (int e = bins.cellStart[neighbour]; e < bins.cellStart[neighbour + 1]; ++e) {
+                        const int j = bins.particles[e];
                         if (j == i || (local[j] >= 0 && j < i)) continue;  // a pair inside once
                         const Vec3 d = p.position[j] - p.position[i];
                         const double dist = d.norm();

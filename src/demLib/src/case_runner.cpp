@@ -117,14 +117,16 @@ std::string CaseRunner::outputDirectory() const {
     return (fs::path(setup_.caseDir) / setup_.output.directory).string();
 }
 
-std::string CaseRunner::latestRestart() const {
-    const fs::path pointer = fs::path(outputDirectory()) / "restart" / "latest";
-    std::ifstream in(pointer);
+std::string latestRestartFile(const CaseSetup& setup) {
+    const fs::path dir = fs::path(setup.caseDir) / setup.output.directory / "restart";
+    std::ifstream in(dir / "latest");
     std::string name;
     if (!(in >> name)) return {};
-    const fs::path file = fs::path(outputDirectory()) / "restart" / name;
+    const fs::path file = dir / name;
     return fs::exists(file) ? file.string() : std::string();
 }
+
+std::string CaseRunner::latestRestart() const { return latestRestartFile(setup_); }
 
 void CaseRunner::performDueInsertions() {
     while (insertionDueAt(simulation_->time())) {

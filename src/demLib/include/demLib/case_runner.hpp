@@ -21,6 +21,10 @@ struct RunOptions {
     double progressInterval = 5.0;
 };
 
+// The newest restart file of a case (<case>/<output>/restart/latest names it),
+// or an empty string when there is none.
+std::string latestRestartFile(const CaseSetup& setup);
+
 class CaseRunner {
 public:
     CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream& log);
