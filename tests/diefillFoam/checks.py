@@ -5,9 +5,17 @@ measured and what was expected, and exits 0 (pass) or 1 (fail).
   terminal LOG RHO_P RHO_F MU D G [LAW]     terminal velocity vs the force balance
                                              with LAW's single-sphere drag
                                              (SchillerNaumann, default, or Dallavalle)
-  balance LOG                                drag on particles == air's loss
-  ergun CASE TIME:U... D MU RHO L [LAW]      bed pressure drop vs LAW's closed form
-                                             (Ergun, default, KochHill or DiFelice)
+  balance LOG                                the exchange terms handed to the air
+                                             (air's loss) == the drag on the particles:
+                                             the weights of each particle's share over
+                                             the cells sum to 1 (a bookkeeping check;
+                                             the solved balance is checked by ergun
+                                             and fluidisation)
+  ergun CASE TIME:U... D MU RHO L [LAW] [porosity=EPS]
+                                             bed pressure drop vs LAW's closed form
+                                             (Ergun, default, KochHill or DiFelice);
+                                             with porosity=, the bed's measured
+                                             porosity must also be EPS (1e-4)
   centre CASE D SPACING CELL                 centre void fraction == lattice porosity
   fluidisation plateau|umf|support CASE TIME CELLS N D RHO_P RHO MU G A L
                                              pressure-drop plateau, or u_mf and the
@@ -123,7 +131,8 @@ def bed_pressure_gradient(law, eps, u, d, mu, rho):
 
 def ergun(args):
     case, pairs = args[0], [a for a in args[1:] if ":" in a]
-    numbers = [a for a in args[1:] if ":" not in a]
+    expected_eps = [float(a.split("=", 1)[1]) for a in args[1:] if a.startswith("porosity=")]
+    numbers = [a for a in args[1:] if ":" not in a and "=" not in a]
     d, mu, rho, length = map(float, numbers[:4])
     law = numbers[4] if len(numbers) > 4 else "Ergun"
     rows = [l.split() for l in open(f"{case}/postProcessing/bedPressure/0/p") if not l.startswith("#")]
@@ -142,6 +151,12 @@ def ergun(args):
         return False
     print(f"    bed porosity measured from alpha.air: {eps:.6f}")
     ok = True
+    for want in expected_eps:
+        # The closed forms are steep in eps (Ergun's viscous term ~ (1-eps)^2/eps^3): a
+        # wrong void fraction fed into them would hide behind a matching pressure drop.
+        good = abs(eps - want) < 1e-4
+        print(f"    expected porosity {want:.6f} (the lattice's): {'ok' if good else 'WRONG'}")
+        ok = ok and good
     out = open(f"{case}/ergun.figures", "w")
     for p in pairs:
         t, u = map(float, p.split(":"))
