@@ -119,6 +119,8 @@ int main(int argc, char** argv) {
                 throw dem::InputError("demStability: -restart latest: no restart file found in '" +
                                       (fs::path(setup.caseDir) / setup.output.directory / "restart").string() +
                                       "' (run the case first, or give -restart FILE)");
+        } else {
+            dem::requireRestartFile(setup, restart, "demStability");
         }
         // The bed is analysed, not run: the a-priori checks are reported below, not enforced.
         setup.settings.allowLargeTimeStep = true;

@@ -46,6 +46,7 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
             throw InputError("-restart latest: no restart file found in '" + (out / "restart").string() + "'");
     }
     if (!restart.empty()) {
+        if (options_.restartFrom != "latest") requireRestartFile(setup_, restart, "demRun");
         simulation_->readRestart(restart);
         startTime_ = simulation_->time();
         readRunnerState(restart);
@@ -124,6 +125,18 @@ std::string latestRestartFile(const CaseSetup& setup) {
     if (!(in >> name)) return {};
     const fs::path file = dir / name;
     return fs::exists(file) ? file.string() : std::string();
+}
+
+void requireRestartFile(const CaseSetup& setup, const std::string& file, const std::string& tool) {
+    if (fs::exists(file)) return;
+    std::string message = tool + ": -restart '" + file + "': no such file";
+    const fs::path path(file);
+    if (path.is_relative()) {
+        message += " (a relative path is taken from the current directory, " + fs::current_path().string() + ")";
+        const fs::path inCase = fs::path(setup.caseDir) / path;
+        if (fs::exists(inCase)) message += "; did you mean '" + inCase.string() + "'?";
+    }
+    throw InputError(message + "; expected a restart file or 'latest' (the newest one of the case)");
 }
 
 std::string CaseRunner::latestRestart() const { return latestRestartFile(setup_); }

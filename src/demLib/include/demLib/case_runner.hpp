@@ -25,6 +25,11 @@ struct RunOptions {
 // or an empty string when there is none.
 std::string latestRestartFile(const CaseSetup& setup);
 
+// Throws InputError unless `file`, given to `tool` with -restart, exists.  A
+// relative path is taken from the current directory (as every path on a
+// command line); where the case holds a file by that path, the message says so.
+void requireRestartFile(const CaseSetup& setup, const std::string& file, const std::string& tool);
+
 class CaseRunner {
 public:
     CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream& log);
