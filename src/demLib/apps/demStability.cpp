@@ -8,7 +8,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
-#include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <string>
@@ -19,8 +18,6 @@
 #include "demLib/error.hpp"
 #include "demLib/simulation.hpp"
 #include "demLib/version.hpp"
-
-namespace fs = std::filesystem;
 
 namespace {
 
@@ -113,15 +110,7 @@ int main(int argc, char** argv) {
             }
         }
         dem::CaseSetup setup = dem::readCaseSetup(caseDir);
-        if (restart == "latest") {
-            restart = dem::latestRestartFile(setup);
-            if (restart.empty())
-                throw dem::InputError("demStability: -restart latest: no restart file found in '" +
-                                      (fs::path(setup.caseDir) / setup.output.directory / "restart").string() +
-                                      "' (run the case first, or give -restart FILE)");
-        } else {
-            dem::requireRestartFile(setup, restart, "demStability");
-        }
+        restart = dem::restartFileFor(setup, restart, "demStability");
         // The bed is analysed, not run: the a-priori checks are reported below, not enforced.
         setup.settings.allowLargeTimeStep = true;
         std::unique_ptr<dem::Simulation> sim = dem::makeSimulation(setup);

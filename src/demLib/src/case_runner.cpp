@@ -39,14 +39,9 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
     const fs::path out = outputDirectory();
     fs::create_directories(out / "restart");
 
-    std::string restart = options_.restartFrom;
-    if (restart == "latest") {
-        restart = latestRestart();
-        if (restart.empty())
-            throw InputError("-restart latest: no restart file found in '" + (out / "restart").string() + "'");
-    }
+    const std::string restart =
+        options_.restartFrom.empty() ? std::string() : restartFileFor(setup_, options_.restartFrom, "");
     if (!restart.empty()) {
-        if (options_.restartFrom != "latest") requireRestartFile(setup_, restart, "demRun");
         simulation_->readRestart(restart);
         startTime_ = simulation_->time();
         readRunnerState(restart);
@@ -127,10 +122,19 @@ std::string latestRestartFile(const CaseSetup& setup) {
     return fs::exists(file) ? file.string() : std::string();
 }
 
-void requireRestartFile(const CaseSetup& setup, const std::string& file, const std::string& tool) {
-    if (fs::exists(file)) return;
-    std::string message = tool + ": -restart '" + file + "': no such file";
-    const fs::path path(file);
+std::string restartFileFor(const CaseSetup& setup, const std::string& arg, const std::string& tool) {
+    const std::string who = tool.empty() ? std::string() : tool + ": ";
+    if (arg == "latest") {
+        const std::string file = latestRestartFile(setup);
+        if (file.empty())
+            throw InputError(who + "-restart latest: no restart file found in '" +
+                             (fs::path(setup.caseDir) / setup.output.directory / "restart").string() +
+                             "' (run the case first, or give -restart FILE)");
+        return file;
+    }
+    if (fs::exists(arg)) return arg;
+    std::string message = who + "-restart '" + arg + "': no such file";
+    const fs::path path(arg);
     if (path.is_relative()) {
         message += " (a relative path is taken from the current directory, " + fs::current_path().string() + ")";
         const fs::path inCase = fs::path(setup.caseDir) / path;
@@ -138,8 +142,6 @@ void requireRestartFile(const CaseSetup& setup, const std::string& file, const s
     }
     throw InputError(message + "; expected a restart file or 'latest' (the newest one of the case)");
 }
-
-std::string CaseRunner::latestRestart() const { return latestRestartFile(setup_); }
 
 void CaseRunner::performDueInsertions() {
     while (insertionDueAt(simulation_->time())) {

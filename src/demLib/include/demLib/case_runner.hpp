@@ -25,10 +25,12 @@ struct RunOptions {
 // or an empty string when there is none.
 std::string latestRestartFile(const CaseSetup& setup);
 
-// Throws InputError unless `file`, given to `tool` with -restart, exists.  A
-// relative path is taken from the current directory (as every path on a
-// command line); where the case holds a file by that path, the message says so.
-void requireRestartFile(const CaseSetup& setup, const std::string& file, const std::string& tool);
+// The restart file that `-restart ARG` names: 'latest' (the newest one of the
+// case) or a file, whose relative path is taken from the current directory (as
+// every path on a command line).  Throws InputError, naming the option, when
+// there is none (and the case's file by that path, if it has one); the message
+// starts with "tool: " (empty: the caller adds its own name, as demRun does).
+std::string restartFileFor(const CaseSetup& setup, const std::string& arg, const std::string& tool);
 
 class CaseRunner {
 public:
@@ -43,7 +45,6 @@ public:
     Simulation& simulation() { return *simulation_; }
     const CaseSetup& setup() const { return setup_; }
     std::string outputDirectory() const;
-    std::string latestRestart() const;
 
 private:
     // Most steps advanceTo hands the engine in one call (keeps the progress
