@@ -2,7 +2,7 @@
 //
 //   demBench settle -case DIR -out PREFIX [-threads N] [-placement rsa|lattice|bed [-bed FILE]]
 //                   [-packing PHI] [-gravityFactor G] [-settleTime T] [-relaxTime T]
-//                   [-speedTolerance V]
+//                   [-speedTolerance V] [-quietSamples Q]
 //       Builds the bed of DIR/constant/demProperties (its first insertion
 //       block: region, size distribution, count) and lets it settle; writes
 //       PREFIX.bed (text: "x y z radius" per particle, the input of both demLib
@@ -27,7 +27,9 @@
 // Settling from a loose packing under gravity takes long in physical time
 // (the top of the column falls by half the bed height); -gravityFactor G > 1
 // shortens it (sqrt(G) times), after which the bed relaxes under 1 g for
-// -relaxTime, so the stored bed carries the 1 g overlaps.
+// -relaxTime, so the stored bed carries the 1 g overlaps.  The relaxation ends
+// early once the rms speed has stayed below -speedTolerance for Q samples in a
+// row (default 4, 2000 steps).
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -109,11 +111,17 @@ struct Options {
     std::string get(const std::string& k, const std::string& fallback = "") const {
         const auto it = values.find(k);
         if (it != values.end()) return it->second;
-        if (fallback.empty()) throw dem::InputError("demBench: option -" + k + " is required");
+        if (fallback.empty()) throw dem::InputError("option -" + k + " is required");
         return fallback;
     }
     double number(const std::string& k, double fallback) const {
-        return has(k) ? std::atof(values.at(k).c_str()) : fallback;
+        if (!has(k)) return fallback;
+        const std::string& text = values.at(k);
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        if (text.empty() || *end != '\0' || !std::isfinite(v))
+            throw dem::InputError("option -" + k + " expects a number, got '" + text + "'");
+        return v;
     }
 };
 
@@ -132,7 +140,7 @@ std::vector<dem::InsertedParticle> randomSequentialAddition(const dem::Insertion
     const dem::SizeDistribution& dist = *spec.distribution;
     std::size_t count = spec.request.targetCount;
     if (count == 0)
-        throw dem::InputError("demBench: the benchmark case's insertion block must give 'count'");
+        throw dem::InputError("the benchmark case's insertion block must give 'count'");
     std::vector<double> d = dem::drawDiametersForCount(dist, count, spec.request.placement.seed);
     std::sort(d.begin(), d.end(), std::greater<double>());
     double solid = 0.0;
@@ -184,7 +192,7 @@ std::vector<dem::InsertedParticle> randomSequentialAddition(const dem::Insertion
         }
         if (!done) {
             std::ostringstream s;
-            s << "demBench: random sequential addition placed only " << placed.size() << " of " << count
+            s << "random sequential addition placed only " << placed.size() << " of " << count
               << " particles at packing fraction " << packingFraction
               << "; expected a lower -packing or a larger insertion region";
             throw dem::InputError(s.str());
@@ -227,29 +235,37 @@ std::vector<dem::InsertedParticle> currentBed(const dem::ParticleStore& p, const
     return bed;
 }
 
-// Runs until `time` has passed or, after a tenth of it, the rms speed is below
-// `tolerance`; returns the simulated time.
-double settleFor(dem::Simulation& sim, double time, double tolerance, const std::string& phase) {
+// Runs until `time` has passed or, after a tenth of it, the rms speed has been
+// below `tolerance` in `quietSamples` samples in a row (a sample every 500
+// steps); returns the simulated time.  One quiet sample is not rest: a settled
+// bed rings in its vertical mode (period about 0.01 s for the 50k bed), and a
+// sample near a node of that mode reads low while the bed still moves.
+double settleFor(dem::Simulation& sim, double time, double tolerance, int quietSamples, const std::string& phase) {
     const auto start = Clock::now();
     const long steps = static_cast<long>(std::ceil(time / sim.timeStep()));
     const long chunk = 500;
     long done = 0;
+    int quiet = 0;
     while (done < steps) {
         const long k = std::min(chunk, steps - done);
         sim.step(k);
         done += k;
         const double v = rmsSpeed(sim.particles());
+        quiet = v < tolerance ? quiet + 1 : 0;
         std::cout << phase << ": t " << std::setprecision(4) << done * sim.timeStep() << " s, rms speed " << v
                   << " m/s, coordination " << sim.coordinationNumber() << ", " << std::setprecision(3)
                   << secondsSince(start) << " s wall" << std::endl;
-        if (done * sim.timeStep() > 0.1 * time && v < tolerance) break;
+        if (done * sim.timeStep() > 0.1 * time && quiet >= quietSamples) break;
     }
+    if (quiet < quietSamples)
+        std::cout << phase << ": stopped at the time limit, not at rest (rms speed above " << tolerance
+                  << " m/s in the last " << quietSamples << " samples)" << std::endl;
     return done * sim.timeStep();
 }
 
 std::vector<dem::InsertedParticle> readBed(const std::string& file) {
     std::ifstream in(file);
-    if (!in) throw dem::InputError("demBench: cannot open bed file '" + file + "'");
+    if (!in) throw dem::InputError("cannot open bed file '" + file + "'");
     std::vector<dem::InsertedParticle> bed;
     std::string line;
     while (std::getline(in, line)) {
@@ -257,7 +273,7 @@ std::vector<dem::InsertedParticle> readBed(const std::string& file) {
         std::istringstream s(line);
         dem::InsertedParticle q;
         if (!(s >> q.position.x() >> q.position.y() >> q.position.z() >> q.radius))
-            throw dem::InputError("demBench: bed file '" + file + "': expected 'x y z radius' in line '" + line + "'");
+            throw dem::InputError("bed file '" + file + "': expected 'x y z radius' in line '" + line + "'");
         bed.push_back(q);
     }
     return bed;
@@ -283,17 +299,20 @@ int settle(const Options& o) {
     } else if (placement == "bed") {  // continue settling a stored bed
         sim->insert(readBed(o.get("bed")), spec.materialIndex, dem::Vec3::Zero(), "bed");
     } else {
-        throw dem::InputError("demBench: -placement expects 'rsa', 'lattice' or 'bed'");
+        throw dem::InputError("-placement expects 'rsa', 'lattice' or 'bed'");
     }
     std::cout << "settle: " << sim->particles().size() << " particles placed (" << placement << ")" << std::endl;
     const double tolerance = o.number("speedTolerance", 2e-3);
-    settleFor(*sim, o.number("settleTime", 0.05), tolerance, "settle");
+    const double quietSamples = o.number("quietSamples", 4);
+    if (quietSamples < 1 || quietSamples != std::floor(quietSamples))
+        throw dem::InputError("-quietSamples expects a whole number >= 1, got " + o.get("quietSamples"));
+    settleFor(*sim, o.number("settleTime", 0.05), tolerance, 1, "settle");
 
     // Relax under the true gravity from rest, then store.
     std::unique_ptr<dem::Simulation> relaxed = dem::makeSimulation(setup);
     relaxed->insert(currentBed(sim->particles(), sim->walls(), sim->time()), spec.materialIndex, dem::Vec3::Zero(), spec.context);
     sim.reset();
-    settleFor(*relaxed, o.number("relaxTime", 0.01), tolerance, "relax");
+    settleFor(*relaxed, o.number("relaxTime", 0.01), tolerance, static_cast<int>(quietSamples), "relax");
 
     const std::vector<dem::InsertedParticle> settled =
         currentBed(relaxed->particles(), relaxed->walls(), relaxed->time());
@@ -303,7 +322,7 @@ int settle(const Options& o) {
     bed << std::setprecision(17);
     for (const dem::InsertedParticle& q : settled)
         bed << q.position.x() << ' ' << q.position.y() << ' ' << q.position.z() << ' ' << q.radius << '\n';
-    if (!bed) throw dem::RuntimeError("demBench: cannot write '" + out + ".bed'");
+    if (!bed) throw dem::RuntimeError("cannot write '" + out + ".bed'");
     relaxed->writeRestart(out + ".restart.h5");
     std::cout << "settle: wrote " << out << ".bed and " << out << ".restart.h5" << std::endl;
     return 0;
@@ -521,6 +540,7 @@ void usage(std::ostream& out) {
     out << "Usage: demBench settle -case DIR -out PREFIX [-threads N] [-placement rsa|lattice|bed -bed FILE]\n"
            "                       [-packing PHI]\n"
            "                       [-gravityFactor G] [-settleTime T] [-relaxTime T] [-speedTolerance V]\n"
+           "                       [-quietSamples Q]\n"
            "       demBench time -case DIR -bed FILE -steps K [-threads N | -ranks R] [-sample S]\n"
            "       demBench copies -case DIR -bed FILE -steps K [-copies C]   (C independent 1-thread runs at once)\n"
            "Benchmark driver of bench/run; see docs/performance.md.\n";
