@@ -30,10 +30,10 @@ Foam::diefill::progressReport::progressReport
 )
 :
     runTime_(runTime),
-    startTime_(runTime.value()),
     reportInterval_(reportInterval),
     clock_(),
-    lastReport_(0)
+    lastReport_(0),
+    estimate_(runTime.value(), runTime.endTime().value())
 {}
 
 
@@ -49,16 +49,15 @@ void Foam::diefill::progressReport::update()
     }
     lastReport_ = elapsed;
 
-    const scalar done = runTime_.value() - startTime_;
-    const scalar left = endTime - runTime_.value();
-    const scalar span = max(endTime - startTime_, SMALL);
+    estimate_.add(elapsed, runTime_.value());
+    const scalar left = estimate_.secondsLeft();
 
     Info<< "Progress: t = " << runTime_.timeName() << " s of " << endTime
-        << " s (" << std::round(1000*done/span)/10 << " %), elapsed "
+        << " s (" << std::round(1000*estimate_.fractionDone())/10 << " %), elapsed "
         << formatSeconds(elapsed).c_str();
-    if (done > 0)
+    if (left >= 0)
     {
-        Info<< ", ETA " << formatSeconds(elapsed*left/done).c_str();
+        Info<< ", ETA " << formatSeconds(left).c_str();
     }
     Info<< endl;
 }

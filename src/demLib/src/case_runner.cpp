@@ -97,6 +97,7 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
     }
     wallStart_ = lastProgress_ = std::chrono::steady_clock::now();
     stepsAtStart_ = simulation_->stepCount();
+    estimate_ = ProgressEstimate(startTime_, setup_.endTime);
 }
 
 void CaseRunner::readRunnerState(const std::string& restartFile) {
@@ -269,16 +270,16 @@ void CaseRunner::progress(bool force) {
     lastProgress_ = now;
     const Simulation& s = *simulation_;
     const double elapsed = std::chrono::duration<double>(now - wallStart_).count();
-    const double done = s.time() - startTime_;
-    const double remaining = setup_.endTime - s.time();
-    const double eta = done > 0.0 ? elapsed * remaining / done : 0.0;
+    estimate_.add(elapsed, s.time());
+    const double eta = estimate_.secondsLeft();
     const double particleSteps = static_cast<double>(s.stepCount() - stepsAtStart_) * s.particles().size();
     log_ << std::fixed << std::setprecision(4) << "t = " << s.time() << " s (" << std::setprecision(1)
          << 100.0 * s.time() / setup_.endTime << " %)" << std::defaultfloat << std::setprecision(6)
          << "  step " << s.stepCount() << "  particles " << s.particles().size() << "  KE "
          << s.particles().kineticEnergy() << " J  lost " << s.lostCount() << "  "
          << std::setprecision(3) << (elapsed > 0 ? particleSteps / elapsed : 0.0) << " particle-steps/s"
-         << "  elapsed " << formatDuration(elapsed) << "  ETA " << formatDuration(eta) << std::endl;
+         << "  elapsed " << formatDuration(elapsed) << "  ETA " << (eta >= 0.0 ? formatDuration(eta) : "-")
+         << std::endl;
 }
 
 bool CaseRunner::insertionDueAt(double now) const {

@@ -11,6 +11,7 @@
 
 #include "demLib/case_setup.hpp"
 #include "demLib/field_output.hpp"
+#include "demLib/progress_estimate.hpp"
 
 namespace dem {
 
@@ -82,6 +83,7 @@ private:
     double startTime_ = 0.0;
     std::chrono::steady_clock::time_point wallStart_, lastProgress_;
     long stepsAtStart_ = 0;
+    ProgressEstimate estimate_{0.0, 0.0};  // the ETA, from the pace of the last minutes
 };
 
 }  // namespace dem
