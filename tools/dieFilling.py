@@ -268,9 +268,16 @@ def report_before_opening(case, out, props, s, frames, poured, fill, opening, en
     if run_time is not None:
         res["runTime"] = {"value": run_time, "unit": "s", "description": "wall time of the run"}
     results.write(case, res)
+    # A case that fullRun manages (DIR/case beside DIR/run.sh) is continued with fullRun.
+    run_dir = os.path.dirname(os.path.abspath(case))
+    if os.path.exists(os.path.join(run_dir, "run.sh")) and os.path.isdir(os.path.join(run_dir, "build")):
+        how = ("if it no longer runs (tutorials/dieFilling/fullRun status %s), continue it with "
+               "tutorials/dieFilling/fullRun continue %s" % (run_dir, run_dir))
+    else:
+        how = "run ./Allrun again to continue"
     print("dieFilling (%s, %s): run in progress at t = %g s of %g s; the die opens at t = %g s: the bed profile, "
-          "the angles and the mass lost at opening come once the run is past it (run ./Allrun again to continue)"
-          % ("wet" if wet else "dry", "air" if with_air else "vacuum", t[-1], end_time, opening))
+          "the angles and the mass lost at opening come once the run is past it (%s)"
+          % ("wet" if wet else "dry", "air" if with_air else "vacuum", t[-1], end_time, opening, how))
     print("    so far: %.1f g poured, fill ratio %.3f, die 50 %% / 90 %% full at t = %s / %s"
           % (poured * 1e3, fill[-1], f"{t50:.3f} s" if t50 is not None else "not yet",
              f"{t90:.3f} s" if t90 is not None else "not yet"))
