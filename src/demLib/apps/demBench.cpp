@@ -123,6 +123,14 @@ struct Options {
             throw dem::InputError("option -" + k + " expects a number, got '" + text + "'");
         return v;
     }
+    // A count: a whole number >= least.
+    long wholeNumber(const std::string& k, long fallback, long least) const {
+        const double v = number(k, static_cast<double>(fallback));
+        if (v != std::floor(v) || v < static_cast<double>(least))
+            throw dem::InputError("option -" + k + " expects a whole number >= " + std::to_string(least) + ", got '" +
+                                  values.at(k) + "'");
+        return static_cast<long>(v);
+    }
 };
 
 struct BedParticle {
@@ -303,16 +311,14 @@ int settle(const Options& o) {
     }
     std::cout << "settle: " << sim->particles().size() << " particles placed (" << placement << ")" << std::endl;
     const double tolerance = o.number("speedTolerance", 2e-3);
-    const double quietSamples = o.number("quietSamples", 4);
-    if (quietSamples < 1 || quietSamples != std::floor(quietSamples))
-        throw dem::InputError("-quietSamples expects a whole number >= 1, got " + o.get("quietSamples"));
+    const int quietSamples = static_cast<int>(o.wholeNumber("quietSamples", 4, 1));
     settleFor(*sim, o.number("settleTime", 0.05), tolerance, 1, "settle");
 
     // Relax under the true gravity from rest, then store.
     std::unique_ptr<dem::Simulation> relaxed = dem::makeSimulation(setup);
     relaxed->insert(currentBed(sim->particles(), sim->walls(), sim->time()), spec.materialIndex, dem::Vec3::Zero(), spec.context);
     sim.reset();
-    settleFor(*relaxed, o.number("relaxTime", 0.01), tolerance, static_cast<int>(quietSamples), "relax");
+    settleFor(*relaxed, o.number("relaxTime", 0.01), tolerance, quietSamples, "relax");
 
     const std::vector<dem::InsertedParticle> settled =
         currentBed(relaxed->particles(), relaxed->walls(), relaxed->time());
@@ -333,8 +339,8 @@ int settle(const Options& o) {
 // for K threads on one simulation; bench/run (d) prints it beside them).
 int independentCopies(const Options& o) {
     const std::string caseDir = o.get("case");
-    const int copies = static_cast<int>(o.number("copies", 2));
-    const long steps = static_cast<long>(o.number("steps", 1000));
+    const int copies = static_cast<int>(o.wholeNumber("copies", 2, 1));
+    const long steps = o.wholeNumber("steps", 1000, 0);
     if (copies < 1) throw dem::InputError("demBench copies: -copies expects an integer >= 1");
     const std::vector<dem::InsertedParticle> bed = readBed(o.get("bed"));
     std::vector<double> rate(copies, 0.0);
@@ -428,8 +434,8 @@ int timeStepsOnRanks(const Options& o, int ranks) {
         throw dem::InputError("demBench time: -ranks runs dry beds only (" + setup.propertiesFile +
                               " sets waterContent; the domain decomposition has no capillary model)");
     const int material = setup.insertions.empty() ? 0 : setup.insertions.front().materialIndex;
-    const long steps = static_cast<long>(o.number("steps", 1000));
-    const long sample = std::max(1L, static_cast<long>(o.number("sample", 100)));
+    const long steps = o.wholeNumber("steps", 1000, 0);
+    const long sample = std::max(1L, o.wholeNumber("sample", 100, 0));
     const std::vector<dem::InsertedParticle> bed = readBed(o.get("bed"));
     const dem::SlabDecomposition slabs = equalCountSlabs(bed, ranks);
     const std::size_t n = bed.size();
@@ -476,16 +482,15 @@ int timeStepsOnRanks(const Options& o, int ranks) {
 
 int timeSteps(const Options& o) {
     if (o.has("ranks")) {
-        const int ranks = std::atoi(o.get("ranks").c_str());
-        if (ranks < 1) throw dem::InputError("demBench time: -ranks expects an integer >= 1, got '" + o.get("ranks") + "'");
+        const int ranks = static_cast<int>(o.wholeNumber("ranks", 1, 1));
         if (o.has("threads")) throw dem::InputError("demBench time: give -threads or -ranks, not both");
         return timeStepsOnRanks(o, ranks);
     }
     const std::string caseDir = o.get("case");
     dem::CaseSetup setup = dem::readCaseSetup(caseDir);
     const int material = setup.insertions.empty() ? 0 : setup.insertions.front().materialIndex;
-    const long steps = static_cast<long>(o.number("steps", 1000));
-    const long sample = std::max(1L, static_cast<long>(o.number("sample", 100)));
+    const long steps = o.wholeNumber("steps", 1000, 0);
+    const long sample = std::max(1L, o.wholeNumber("sample", 100, 0));
 
     const std::size_t rssBefore = procStatusBytes("VmRSS");
     std::unique_ptr<dem::Simulation> sim = dem::makeSimulation(setup);
@@ -564,10 +569,10 @@ int main(int argc, char** argv) {
         }
         o.values[a.substr(1)] = argv[++i];
     }
-#ifdef _OPENMP
-    if (o.has("threads")) omp_set_num_threads(std::max(1, std::atoi(o.values["threads"].c_str())));
-#endif
     try {
+#ifdef _OPENMP
+        if (o.has("threads")) omp_set_num_threads(static_cast<int>(std::max(1L, o.wholeNumber("threads", 1, 0))));
+#endif
         if (command == "settle") return settle(o);
         if (command == "time") return timeSteps(o);
         if (command == "copies") return independentCopies(o);
