@@ -322,4 +322,41 @@ TEST(ParticleParticleNeighborList, ListsEveryPairOfAWidelyPolydisperseBed) {
     }
 }
 
+// A bed whose pair count creeps up by a little at every build (a settling bed
+// over a few thousand steps) keeps its list's memory: the build buffers, which
+// trade places with the list's arrays on one thread, are replaced only when
+// they hold less than the old pairs and a sixteenth.  They were replaced at
+// every build whose count exceeded the one two builds before (+1.5 MB per
+// other build on the 50k bench bed, docs/performance.md round 13).
+TEST(ParticleParticleNeighborList, MemoryStaysPutWhileThePairCountCreepsUp) {
+    ThreadCount scope(1);
+    const double radius = 1e-3, skin = 0.4e-3;
+    dem::ParticleStore p = jitteredLattice(14, radius, 0.3e-3, 7);
+    dem::ParticleParticleNeighborList list;
+    list.setRanges(skin, 0.0);
+    list.build(p);
+    list.build(p);  // both sets of buffers exist from here on
+    // The pair-sized arrays the list and its build buffers hold (the slot
+    // array, which also trades places with a buffer, is counted with the
+    // history records, which grow with the contacts by their own rule): the
+    // two sets alternate, so the figure repeats every second build.
+    const auto pairArrayBytes = [&] { return list.neighbors().capacity() * sizeof(int) + list.buildBufferBytes(); };
+    std::vector<std::size_t> bytes{pairArrayBytes()};
+    const std::size_t pairsAtStart = list.pairCount();
+    Vec3 centre = Vec3::Zero();
+    for (const Vec3& x : p.position) centre += x;
+    centre /= static_cast<double>(p.size());
+    for (int round = 0; round < 8; ++round) {
+        const std::size_t before = list.pairCount();
+        for (Vec3& x : p.position) x = centre + (x - centre) * (1.0 - 4e-4);
+        list.build(p);
+        ASSERT_GT(list.pairCount(), before) << "round " << round << ": the test needs a growing pair count";
+        bytes.push_back(pairArrayBytes());
+        if (bytes.size() > 2) {
+            EXPECT_EQ(bytes.back(), bytes[bytes.size() - 3]) << "round " << round << ": " << list.pairCount() << " pairs";
+        }
+    }
+    EXPECT_LT(list.pairCount(), pairsAtStart + pairsAtStart / 16);
+}
+
 }  // namespace
