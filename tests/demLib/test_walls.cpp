@@ -676,6 +676,116 @@ TEST(TriangleMesh, ContainsPointMatchesAnalyticSolids) {
     EXPECT_EQ(wrong, 0);
 }
 
+// A closed box whose faces are each split into cells x cells squares: many
+// small triangles, so the triangle grid has many cells for a ray to walk.
+std::vector<Triangle> fineBoxTriangles(const Vec3& lo, const Vec3& hi, int cells) {
+    std::vector<Triangle> triangles;
+    for (const Triangle& coarse : boxTriangles(lo, hi)) {
+        // Map each coarse triangle's parameter square onto cells x cells
+        // sub-triangles: the pair of coarse triangles of a face is split alike.
+        const Vec3& a = coarse[0];
+        const Vec3 u = coarse[1] - a, v = coarse[2] - coarse[1];
+        for (int i = 0; i < cells; ++i) {
+            for (int j = 0; j <= i; ++j) {
+                auto at = [&](double s, double t) { return Vec3(a + (s / cells) * u + (t / cells) * v); };
+                triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+                if (j < i) triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+            }
+        }
+    }
+    return triangles;
+}
+
+// UV sphere of radius r about the origin (closed; poles as triangle fans).
+std::vector<Triangle> sphereTriangles(double r, int rings, int segments) {
+    auto point = [&](int ring, int segment) {
+        const double polar = pi * ring / rings, azimuth = 2 * pi * segment / segments;
+        return Vec3(r * std::sin(polar) * std::cos(azimuth), r * std::sin(polar) * std::sin(azimuth), r * std::cos(polar));
+    };
+    std::vector<Triangle> triangles;
+    for (int ring = 0; ring < rings; ++ring) {
+        for (int segment = 0; segment < segments; ++segment) {
+            const Vec3 a = point(ring, segment), b = point(ring + 1, segment), c = point(ring + 1, segment + 1),
+                       d = point(ring, segment + 1);
+            if (ring > 0) triangles.push_back({a, b, d});
+            if (ring + 1 < rings) triangles.push_back({b, c, d});
+        }
+    }
+    return triangles;
+}
+
+TEST(TriangleMesh, ClosedMeshesAreTold) {
+    EXPECT_TRUE(dem::TriangleMesh(boxTriangles(Vec3(0, 0, 0), Vec3(1, 2, 3))).isClosed());
+    EXPECT_TRUE(dem::TriangleMesh(prismTriangles(0.0215, 0.05, 24)).isClosed());
+    EXPECT_TRUE(dem::TriangleMesh(sphereTriangles(1.0, 16, 24)).isClosed());
+    EXPECT_TRUE(dem::TriangleMesh(fineBoxTriangles(Vec3(0, 0, 0), Vec3(1, 1, 1), 5)).isClosed());
+    // A flat plate, and a box with one triangle missing, have open borders.
+    EXPECT_FALSE(dem::TriangleMesh(squareTriangles(1.0, 4)).isClosed());
+    auto open = boxTriangles(Vec3(0, 0, 0), Vec3(1, 1, 1));
+    open.pop_back();
+    EXPECT_FALSE(dem::TriangleMesh(open).isClosed());
+}
+
+TEST(TriangleMesh, ContainsPointOnFineMeshesMatchesTheSolid) {
+    // Thousands of triangles in a grid of many cells: the rays walk the grid,
+    // and a triangle listed in several cells along a ray counts once.
+    std::mt19937_64 rng(7);
+    const dem::TriangleMesh box(fineBoxTriangles(Vec3(-0.3, 0.1, 0.2), Vec3(0.5, 0.4, 1.0), 24));
+    ASSERT_EQ(box.triangleCount(), 6u * 2 * 24 * 24);
+    std::uniform_real_distribution<double> x(-0.5, 0.7), y(-0.1, 0.6), z(0.0, 1.2);
+    int wrong = 0, inside = 0;
+    for (int k = 0; k < 20000; ++k) {
+        const Vec3 p(x(rng), y(rng), z(rng));
+        const bool expected = p.x() > -0.3 && p.x() < 0.5 && p.y() > 0.1 && p.y() < 0.4 && p.z() > 0.2 && p.z() < 1.0;
+        inside += expected;
+        if (box.containsPoint(p) != expected) ++wrong;
+    }
+    EXPECT_EQ(wrong, 0);
+    EXPECT_GT(inside, 2000);  // both answers are exercised
+
+    // A sphere of 64 x 32 facets: points clear of the faceted shell by 1 %.
+    const double r = 0.02;
+    const dem::TriangleMesh sphere(sphereTriangles(r, 32, 64));
+    std::uniform_real_distribution<double> across(-1.3 * r, 1.3 * r);
+    wrong = 0;
+    int tested = 0;
+    for (int k = 0; k < 20000; ++k) {
+        const Vec3 p(across(rng), across(rng), across(rng));
+        if (std::abs(p.norm() - r) < 0.01 * r) continue;
+        ++tested;
+        if (sphere.containsPoint(p) != (p.norm() < r)) ++wrong;
+    }
+    EXPECT_EQ(wrong, 0);
+    EXPECT_GT(tested, 19000);
+}
+
+TEST(Wall, EnclosesPointBehindPlanesAndInsideClosedPartsOnly) {
+    const dem::Wall floor{"floor", dem::PlaneWall(Vec3(0, 0, 0.1), Vec3(0, 0, 1)), dem::WallMotion(), 0};
+    EXPECT_TRUE(floor.enclosesPoint(Vec3(3, -2, 0.099), 0.0));
+    EXPECT_FALSE(floor.enclosesPoint(Vec3(3, -2, 0.101), 0.0));
+    // A tube is a shell: both sides are free space.
+    const dem::Wall tube{"tube", dem::CylinderWall(Vec3(0, 0, 0), Vec3(0, 0, 1), 0.02, 0.0, 0.05,
+                                                   dem::CylinderWall::Side::Inside),
+                         dem::WallMotion(), 0};
+    EXPECT_FALSE(tube.enclosesPoint(Vec3(0.03, 0, 0.02), 0.0));
+    EXPECT_FALSE(tube.enclosesPoint(Vec3(0.01, 0, 0.02), 0.0));
+    // A closed part, moved: the test follows its pose at the time asked.
+    dem::Wall block{"block", dem::MeshWall(std::make_shared<const dem::TriangleMesh>(
+                                 boxTriangles(Vec3(0, 0, 0), Vec3(0.01, 0.01, 0.002)))),
+                    dem::WallMotion(), 1};
+    block.motion.addTranslation(1.0, 2.0, Vec3(0.1, 0, 0));
+    EXPECT_TRUE(block.enclosesPoint(Vec3(0.005, 0.005, 0.001), 0.5));
+    EXPECT_FALSE(block.enclosesPoint(Vec3(0.005, 0.005, 0.003), 0.5));
+    EXPECT_FALSE(block.enclosesPoint(Vec3(0.005, 0.005, 0.001), 3.0));  // it has moved 0.1 m on
+    EXPECT_TRUE(block.enclosesPoint(Vec3(0.105, 0.005, 0.001), 3.0));
+    block.motion.setRemovalTime(4.0);
+    EXPECT_FALSE(block.enclosesPoint(Vec3(0.105, 0.005, 0.001), 4.0));  // removed
+    // An open surface (a thin sheet) has no inside.
+    const dem::Wall sheet{"sheet", dem::MeshWall(std::make_shared<const dem::TriangleMesh>(squareTriangles(1.0, 2))),
+                          dem::WallMotion(), 1};
+    EXPECT_FALSE(sheet.enclosesPoint(Vec3(0.5, 0.5, -1e-3), 0.0));
+}
+
 // ================================================================ motion
 
 TEST(WallMotion, TranslationStartsAndStopsOnTime) {

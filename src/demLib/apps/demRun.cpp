@@ -2,6 +2,7 @@
 //   demRun [-case DIR] [-restart FILE|latest] [-threads N] [-help]
 // Reads DIR/constant/demProperties, writes DIR/<output>/ (particle fields as
 // HDF5 + XDMF for ParaView, summary.csv, restart files) and DIR/log.demRun.
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -58,6 +59,14 @@ void usage(std::ostream& out) {
            "docs/case-reference.md.  Exit status: 0 on success, 1 on bad input, 2 on a runtime failure.\n";
 }
 
+// The whole argument as a number, or nothing (atof read "2x" as 2 and "abc" as 0).
+bool parseNumber(const std::string& text, double& value) {
+    if (text.empty()) return false;
+    char* end = nullptr;
+    value = std::strtod(text.c_str(), &end);
+    return *end == '\0' && std::isfinite(value);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -82,13 +91,19 @@ int main(int argc, char** argv) {
         } else if (a == "-restart") {
             options.restartFrom = value("a restart file or 'latest'");
         } else if (a == "-threads") {
-            threads = std::atoi(value("a number of threads").c_str());
-            if (threads <= 0) {
-                std::cerr << "demRun: -threads expects a positive integer\n";
+            const std::string text = value("a number of threads");
+            double n = 0.0;
+            if (!parseNumber(text, n) || n < 1.0 || n != std::floor(n) || n > 4096.0) {
+                std::cerr << "demRun: -threads expects a positive integer, got '" << text << "'\n";
                 return 1;
             }
+            threads = static_cast<int>(n);
         } else if (a == "-endTime") {
-            endTime = std::atof(value("a time in seconds").c_str());
+            const std::string text = value("a time in seconds");
+            if (!parseNumber(text, endTime) || !(endTime > 0.0)) {
+                std::cerr << "demRun: -endTime expects a positive time in seconds, got '" << text << "'\n";
+                return 1;
+            }
         } else if (a == "-quiet") {
             options.progressInterval = 0.0;
         } else {

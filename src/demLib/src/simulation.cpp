@@ -99,6 +99,14 @@ void Simulation::insert(const std::vector<InsertedParticle>& inserted, int mater
                                      "' by " + std::to_string(c.overlap) +
                                      " m; expected every particle clear of the walls");
             }
+            // A centre behind a plane or inside a closed part touches no
+            // surface (or not deeper than its radius) and would be lost or
+            // stuck inside, silently.
+            if (w.enclosesPoint(q.position, time_))
+                throw InputError(context + ": particle " + std::to_string(k) + " at " + formatVec(q.position) +
+                                 " (radius " + std::to_string(q.radius) + ") lies " +
+                                 (std::holds_alternative<PlaneWall>(w.shape) ? "behind" : "inside") + " wall '" +
+                                 w.name + "'; expected every particle clear of the walls");
         }
     }
     // The time step is checked before anything is added, so that a rejected

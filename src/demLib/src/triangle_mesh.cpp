@@ -287,6 +287,16 @@ TriangleMesh::TriangleMesh(const std::vector<Triangle>& triangles, const std::st
     weld(triangles, sourceName);
     buildTopology();
     buildGrid();
+    // Closed: every edge bounds an even number of triangles (two on a
+    // manifold; four where two solids share an edge), so every ray crosses
+    // the surface an even number of times and containsPoint's parity holds.
+    closed_ = true;
+    for (std::size_t e = 0; e + 1 < edgeTriangleStart_.size(); ++e) {
+        if ((edgeTriangleStart_[e + 1] - edgeTriangleStart_[e]) % 2 != 0) {
+            closed_ = false;
+            break;
+        }
+    }
 }
 
 TriangleMesh TriangleMesh::fromStl(const std::string& path, double scale) {
@@ -688,39 +698,78 @@ const std::array<Vec3, 3>& TriangleMesh::parityRays() {
     return rays;
 }
 
+namespace {
+
+// Moller-Trumbore: whether the ray p + s d (s > 0) crosses triangle (a, b, c).
+bool rayCrossesTriangle(const Vec3& p, const Vec3& d, const Vec3& a, const Vec3& b, const Vec3& c) {
+    const Vec3 e1 = b - a;
+    const Vec3 e2 = c - a;
+    const Vec3 pvec = d.cross(e2);
+    const double determinant = e1.dot(pvec);
+    if (std::abs(determinant) <= 1e-14 * e1.norm() * e2.norm()) {
+        return false;  // ray parallel to the triangle
+    }
+    const double inverse = 1.0 / determinant;
+    const Vec3 tvec = p - a;
+    const double u = tvec.dot(pvec) * inverse;
+    if (u < 0.0 || u > 1.0) {
+        return false;
+    }
+    const Vec3 qvec = tvec.cross(e1);
+    const double v = d.dot(qvec) * inverse;
+    if (v < 0.0 || u + v > 1.0) {
+        return false;
+    }
+    return e2.dot(qvec) * inverse > 0.0;
+}
+
+}  // namespace
+
+
 bool TriangleMesh::containsPoint(const Vec3& p) const {
     if (!box_.overlapsSphere(p, 0.0)) {
         return false;
     }
+    // Each ray walks the triangle grid cell by cell (Amanatides and Woo) from
+    // p's cell to the grid's end, so the cost follows the cells it crosses,
+    // not the mesh size.  A triangle is listed in every cell of its box, so a
+    // crossing is found in some cell along the ray, possibly in several: the
+    // crossed triangles are collected and counted once each.
+    std::vector<int> crossed;
     int insideVotes = 0;
     for (const Vec3& direction : parityRays()) {
-        int crossings = 0;
-        for (const auto& tv : triangleVertices_) {
-            // Moller-Trumbore ray-triangle intersection.
-            const Vec3& a = vertices_[tv[0]];
-            const Vec3 e1 = vertices_[tv[1]] - a;
-            const Vec3 e2 = vertices_[tv[2]] - a;
-            const Vec3 pvec = direction.cross(e2);
-            const double determinant = e1.dot(pvec);
-            if (std::abs(determinant) <= 1e-14 * e1.norm() * e2.norm()) {
-                continue;  // ray parallel to the triangle
-            }
-            const double inverse = 1.0 / determinant;
-            const Vec3 tvec = p - a;
-            const double u = tvec.dot(pvec) * inverse;
-            if (u < 0.0 || u > 1.0) {
-                continue;
-            }
-            const Vec3 qvec = tvec.cross(e1);
-            const double v = direction.dot(qvec) * inverse;
-            if (v < 0.0 || u + v > 1.0) {
-                continue;
-            }
-            if (e2.dot(qvec) * inverse > 0.0) {
-                ++crossings;
-            }
+        crossed.clear();
+        std::array<int, 3> cell = cellOf(p);
+        std::array<int, 3> step{};
+        Vec3 nextBoundary, boundaryStep;  // ray parameter of the next cell face per axis, and between faces
+        for (int axis = 0; axis < 3; ++axis) {
+            // The parity rays have no zero component.
+            step[axis] = direction[axis] > 0.0 ? 1 : -1;
+            const double face = grid_.origin[axis] + (cell[axis] + (step[axis] > 0 ? 1 : 0)) * grid_.cellSize;
+            nextBoundary[axis] = (face - p[axis]) / direction[axis];
+            boundaryStep[axis] = grid_.cellSize / std::abs(direction[axis]);
         }
-        insideVotes += crossings % 2;
+        for (;;) {
+            const std::size_t c = (std::size_t(cell[2]) * grid_.dims[1] + cell[1]) * grid_.dims[0] + cell[0];
+            for (int n = grid_.cellStart[c]; n < grid_.cellStart[c + 1]; ++n) {
+                const int t = grid_.cellTriangles[n];
+                const auto& tv = triangleVertices_[t];
+                if (rayCrossesTriangle(p, direction, vertices_[tv[0]], vertices_[tv[1]], vertices_[tv[2]])) {
+                    crossed.push_back(t);
+                }
+            }
+            int axis = 0;
+            if (nextBoundary[1] < nextBoundary[axis]) axis = 1;
+            if (nextBoundary[2] < nextBoundary[axis]) axis = 2;
+            cell[axis] += step[axis];
+            if (cell[axis] < 0 || cell[axis] >= grid_.dims[axis]) {
+                break;
+            }
+            nextBoundary[axis] += boundaryStep[axis];
+        }
+        std::sort(crossed.begin(), crossed.end());
+        const auto distinct = std::unique(crossed.begin(), crossed.end()) - crossed.begin();
+        insideVotes += int(distinct % 2);
     }
     return insideVotes >= 2;
 }

@@ -60,4 +60,18 @@ BoundingBox Wall::boundingBox(double time) const {
     return std::visit([&](const auto& surface) { return transformed(surface.boundingBox(), pose); }, shape);
 }
 
+bool Wall::enclosesPoint(const Vec3& point, double time) const {
+    if (!isActive(time)) {
+        return false;
+    }
+    const Vec3 reference = motion.isStatic() ? point : motion.at(time).applyInverse(point);
+    if (const auto* plane = std::get_if<PlaneWall>(&shape)) {
+        return plane->signedDistance(reference) < 0.0;
+    }
+    if (const auto* mesh = std::get_if<MeshWall>(&shape)) {
+        return mesh->mesh().isClosed() && mesh->mesh().containsPoint(reference);
+    }
+    return false;
+}
+
 }  // namespace dem

@@ -78,10 +78,14 @@ public:
     // How many triangles a query for this sphere tests (diagnostics, tests).
     std::size_t candidateCount(const Vec3& centre, double radius) const;
 
+    // Whether the mesh bounds a solid: every edge is shared by an even number
+    // of triangles (no open border).  containsPoint means something only then.
+    bool isClosed() const { return closed_; }
     // Point-in-solid for a closed mesh: parity of ray crossings, majority vote
     // over three fixed skew rays so that a ray grazing an edge or a vertex
-    // cannot flip the answer.  O(number of triangles); meant for set-up
-    // (particle insertion), not for the time loop.
+    // cannot flip the answer.  Each ray walks the triangle grid, so the cost
+    // follows the grid cells it crosses; meant for set-up (insertion regions,
+    // checking inserted particles), not for the time loop.
     bool containsPoint(const Vec3& p) const;
     // The three unit ray directions containsPoint casts (tests aim them at edges).
     static const std::array<Vec3, 3>& parityRays();
@@ -110,6 +114,7 @@ private:
     std::vector<Vec3> faceNormals_;
     BoundingBox box_;
     double tolerance_ = 0.0;
+    bool closed_ = false;
 
     // Topology.
     std::vector<std::array<int, 3>> triangleEdges_;  // edge id of local edges AB, BC, CA

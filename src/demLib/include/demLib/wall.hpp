@@ -38,6 +38,11 @@ struct Wall {
     // planes, empty once removed).  A sphere whose box misses it has no
     // contact with this wall.
     BoundingBox boundingBox(double time) const;
+    // Whether a point at `time` lies where no particle centre may be: behind
+    // a plane (a one-sided boundary of the half-space in front of it) or
+    // inside a closed mesh (a solid part).  A cylinder is a shell of no
+    // thickness: particles may be on either side of it (e.g. around a tube).
+    bool enclosesPoint(const Vec3& point, double time) const;
 
     bool isActive(double time) const { return motion.isActive(time); }
 };
