@@ -1,4 +1,5 @@
 #include "demCoupling.H"
+#include "checkKeywords.H"
 #include "fvm.H"
 #include "fvc.H"
 #include "mathematicalConstants.H"
@@ -186,6 +187,31 @@ Foam::diefill::demCoupling::demCoupling
     forAll(forceNames, i)
     {
         forces_.set(i, particleForce::New(forceNames[i], dict_));
+    }
+
+    // Every keyword is one the solver reads; a <model>Coeffs block of a model
+    // not selected now may stay (switching models is an edit of one line).
+    {
+        wordList known
+        ({
+            "modelType", "alphaMin", "smoothingLength", "voidFractionModel",
+            "forceModels"
+        });
+        for (const word& name : particleForce::dictionaryConstructorTablePtr_->sortedToc())
+        {
+            known.append(name + "Coeffs");
+        }
+        for (const word& name : voidFractionModel::dictionaryConstructorTablePtr_->sortedToc())
+        {
+            known.append(name + "Coeffs");
+        }
+        checkKeywords(dict_, known);
+    }
+    if (smoothingLength_ < 0)
+    {
+        FatalIOErrorInFunction(dict_)
+            << "smoothingLength must be >= 0 (0: no smoothing), got "
+            << smoothingLength_ << exit(FatalIOError);
     }
 
     // The DEM: the whole case on every rank (see the class description).

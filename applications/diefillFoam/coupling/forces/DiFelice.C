@@ -1,5 +1,6 @@
 #include "DiFelice.H"
 #include "addToRunTimeSelectionTable.H"
+#include "checkKeywords.H"
 #include "mathematicalConstants.H"
 
 namespace Foam
@@ -14,7 +15,9 @@ namespace diefill
 Foam::diefill::DiFelice::DiFelice(const dictionary& coeffs)
 :
     dragForce(coeffs)
-{}
+{
+    checkKeywords(coeffs, wordList());  // no coefficients
+}
 
 
 Foam::scalar Foam::diefill::DiFelice::beta(const particleFluidState& s) const

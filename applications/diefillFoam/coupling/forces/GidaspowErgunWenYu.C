@@ -1,5 +1,6 @@
 #include "GidaspowErgunWenYu.H"
 #include "addToRunTimeSelectionTable.H"
+#include "checkKeywords.H"
 
 namespace Foam
 {
@@ -15,6 +16,7 @@ Foam::diefill::GidaspowErgunWenYu::GidaspowErgunWenYu(const dictionary& coeffs)
     dragForce(coeffs),
     switchVoidFraction_(coeffs.getOrDefault<scalar>("switchVoidFraction", 0.8))
 {
+    checkKeywords(coeffs, {"switchVoidFraction"});
     if (switchVoidFraction_ <= 0 || switchVoidFraction_ >= 1)
     {
         FatalIOErrorInFunction(coeffs)

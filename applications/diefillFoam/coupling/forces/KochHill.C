@@ -1,5 +1,6 @@
 #include "KochHill.H"
 #include "addToRunTimeSelectionTable.H"
+#include "checkKeywords.H"
 
 namespace Foam
 {
@@ -13,7 +14,9 @@ namespace diefill
 Foam::diefill::KochHill::KochHill(const dictionary& coeffs)
 :
     dragForce(coeffs)
-{}
+{
+    checkKeywords(coeffs, wordList());  // no coefficients
+}
 
 
 Foam::scalar Foam::diefill::KochHill::beta(const particleFluidState& s) const

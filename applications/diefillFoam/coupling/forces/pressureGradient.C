@@ -1,5 +1,6 @@
 #include "pressureGradient.H"
 #include "addToRunTimeSelectionTable.H"
+#include "checkKeywords.H"
 
 namespace Foam
 {
@@ -13,7 +14,9 @@ namespace diefill
 Foam::diefill::pressureGradient::pressureGradient(const dictionary& coeffs)
 :
     particleForce(coeffs)
-{}
+{
+    checkKeywords(coeffs, wordList());  // no coefficients
+}
 
 
 Foam::vector Foam::diefill::pressureGradient::explicitForce

@@ -1,5 +1,6 @@
 #include "centreVoidFraction.H"
 #include "addToRunTimeSelectionTable.H"
+#include "checkKeywords.H"
 
 namespace Foam
 {
@@ -17,7 +18,9 @@ Foam::diefill::centreVoidFraction::centreVoidFraction
 )
 :
     voidFractionModel(mesh, coeffs)
-{}
+{
+    checkKeywords(coeffs, wordList());  // no coefficients
+}
 
 
 void Foam::diefill::centreVoidFraction::distribute

@@ -1,5 +1,6 @@
 #include "dividedVoidFraction.H"
 #include "addToRunTimeSelectionTable.H"
+#include "checkKeywords.H"
 
 namespace Foam
 {
@@ -18,6 +19,7 @@ Foam::diefill::dividedVoidFraction::dividedVoidFraction
 :
     voidFractionModel(mesh, coeffs)
 {
+    checkKeywords(coeffs, {"pointsPerDiameter"});
     const label n = coeffs.getOrDefault<label>("pointsPerDiameter", 4);
     if (n < 2)
     {
