@@ -18,3 +18,24 @@ def out_dir(case):
     d = os.path.join(case, "postProcessing")
     os.makedirs(d, exist_ok=True)
     return d
+
+
+def run_main(main, *args):
+    """Runs a tool's main(): a missing file, a missing keyword or a bad value
+    ends with one line naming it and exit status 1, not a Python traceback
+    (set DIEFILL_TRACEBACK=1 to see the traceback)."""
+    name = os.path.basename(sys.argv[0])
+    try:
+        status = main(*args)
+    except (FileNotFoundError, KeyError, ValueError, OSError) as e:
+        if os.environ.get("DIEFILL_TRACEBACK"):
+            raise
+        if isinstance(e, OSError) and e.filename:
+            message = f"{e.strerror}: '{e.filename}'"
+        elif isinstance(e, KeyError) and e.args:
+            message = e.args[0]  # str() of a KeyError adds quotes
+        else:
+            message = e
+        print(f"{name}: error: {message}", file=sys.stderr)
+        sys.exit(1)
+    sys.exit(status or 0)

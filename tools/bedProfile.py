@@ -14,7 +14,7 @@ import os
 
 import numpy as np
 
-from _common import frame_at, out_dir
+from _common import frame_at, out_dir, run_main
 from diefillpost import plots, profile
 
 
@@ -54,4 +54,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    run_main(main)

@@ -33,7 +33,7 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _common import out_dir  # noqa: E402
+from _common import out_dir, run_main  # noqa: E402
 from diefillpost import foamdict, plots, profile, results, series, summary  # noqa: E402
 
 
@@ -427,4 +427,4 @@ def main():
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    run_main(main)

@@ -20,6 +20,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from diefillpost import foamdict, geometry, plate, plots, results, series, summary  # noqa: E402
+from _common import run_main  # noqa: E402
 
 PAPER = {"start": 22.0, "at27": 0.35, "none_left": 37.0, "simulation50": 29.0}
 
@@ -137,4 +138,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    run_main(main)

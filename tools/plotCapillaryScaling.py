@@ -9,12 +9,15 @@ Right: capillary Bond number (capillary force / particle weight) relative to
 l = 1 without eq 9, with eq 9 (kappa = 2.0142) and with kappa = 2.
 """
 import csv
+import os
 import sys
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (backend must be chosen first)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from _common import run_main  # noqa: E402
 
 
 def read_columns(path):
@@ -63,4 +66,4 @@ def main(argv):
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv))
+    run_main(main, sys.argv)

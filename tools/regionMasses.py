@@ -15,7 +15,7 @@ import os
 
 import numpy as np
 
-from _common import out_dir
+from _common import out_dir, run_main
 from diefillpost import geometry, plots, series, summary
 
 
@@ -62,4 +62,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    run_main(main)

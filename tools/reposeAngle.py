@@ -22,6 +22,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from diefillpost import foamdict, geometry, plots, profile, results, series, summary  # noqa: E402
+from _common import run_main  # noqa: E402
 
 PAPER_ANGLE = 28.0
 
@@ -98,4 +99,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    run_main(main)

@@ -8,7 +8,7 @@ Writes postProcessing/<N>.png (N default 'sideView_<time>')."""
 import argparse
 import os
 
-from _common import frame_at, out_dir
+from _common import frame_at, out_dir, run_main
 from diefillpost import plots
 
 
@@ -28,4 +28,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    run_main(main)

@@ -7,8 +7,12 @@ Used by the inclined-plate tutorial for its finite steel plate (a mesh wall is
 two-sided and has edges, unlike an infinite one-sided plane)."""
 import argparse
 import os
+import sys
 
 import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from _common import run_main  # noqa: E402
 
 
 def box_triangles(lo, hi):
@@ -49,4 +53,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    run_main(main)

@@ -329,6 +329,24 @@ def plots_and_results():
     check("results.csv rows", open(cp).read().splitlines()[1:] == ["a,1.5,deg,", "b,1 2,,", "c,x,,"])
 
 
+@test
+def missing_case_is_one_line_and_exit_1():
+    # Every case script, pointed at a folder without a case: one line naming the
+    # script and the missing file, exit status 1, no Python traceback.
+    absent = os.path.join(TMP, "no-such-case")
+    for script, args in (("dieFilling.py", ["-case", absent]), ("reposeAngle.py", ["-case", absent]),
+                         ("inclinedPlate.py", ["-case", absent]), ("regionMasses.py", ["-case", absent]),
+                         ("sideView.py", ["-case", absent]),
+                         ("bedProfile.py", ["-case", absent, "-axis", "0", "0", "0", "0", "0", "1"]),
+                         ("plotCapillaryScaling.py", [os.path.join(absent, "scaling.csv")])):
+        r = subprocess.run([sys.executable, os.path.join(ROOT, "tools", script)] + args, capture_output=True, text=True)
+        lines = r.stderr.strip().splitlines()
+        check(f"{script} without a case: one line naming it, exit 1",
+              r.returncode == 1 and len(lines) == 1 and lines[0].startswith(f"{script}: error: ")
+              and "no-such-case" in lines[0] and "Traceback" not in r.stderr,
+              f"(exit {r.returncode}, stderr {r.stderr.strip()[-300:]!r})")
+
+
 import shutil  # noqa: E402
 
 shutil.rmtree(TMP, ignore_errors=True)
