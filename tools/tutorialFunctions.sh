@@ -36,7 +36,13 @@ tutorial_parse_args() {
                     echo "$(basename "$0"): unknown rolling model '$ROLLING'; expected cdt, epsd2, epsd or none" >&2
                     exit 2 ;;
                 esac ;;
-            -threads) THREADS=${2:?-threads needs a number}; shift ;;
+            -threads)
+                THREADS=${2:?-threads needs a number}; shift
+                # Checked here, before anything is written into the case.
+                case "$THREADS" in ''|*[!0-9]*|0*)
+                    echo "$(basename "$0"): -threads expects a positive whole number, got '$THREADS'" >&2
+                    exit 2 ;;
+                esac ;;
             -h|-help|--help) tutorial_usage; exit 0 ;;
             *) echo "$(basename "$0"): unknown option '$1'" >&2; tutorial_usage >&2; exit 2 ;;
         esac
