@@ -87,6 +87,12 @@ void Simulation::insert(const std::vector<InsertedParticle>& inserted, int mater
                              std::to_string(q.radius) + "; expected a positive radius");
         if (!q.position.allFinite())
             throw InputError(context + ": particle " + std::to_string(k) + " has a non-finite position");
+        // Outside the domain it would be removed as lost at the first step, silently.
+        if (settings_.domain && settings_.domain->loses(q.position))
+            throw InputError(context + ": particle " + std::to_string(k) + " at " + formatVec(q.position) +
+                             " lies outside the simulation domain (keyword 'domain': min " +
+                             formatVec(settings_.domain->min) + ", max " + formatVec(settings_.domain->max) +
+                             "); expected every particle inside it");
         for (const Wall& w : walls_) {
             if (!w.isActive(time_)) continue;
             touching.clear();
