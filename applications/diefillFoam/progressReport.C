@@ -33,7 +33,9 @@ Foam::diefill::progressReport::progressReport
     reportInterval_(reportInterval),
     clock_(),
     lastReport_(0),
-    estimate_(runTime.value(), runTime.endTime().value())
+    // A gap of three report intervals between reports is a stop (fullRun
+    // pause): left out of the pace, so the ETA is right again at once.
+    estimate_(runTime.value(), runTime.endTime().value(), 600, 3*reportInterval)
 {}
 
 

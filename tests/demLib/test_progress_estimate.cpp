@@ -53,6 +53,41 @@ TEST(ProgressEstimate, APauseLeavesTheEstimateOnceItIsOutOfTheWindow) {
     EXPECT_GT(meanSinceStart, 2.0 * expected);  // what the old estimate said
 }
 
+TEST(ProgressEstimate, AStopIsLeftOutOfThePaceAtOnce) {
+    // Samples every 30 s at 0.45 simulated s per hour; the process is stopped
+    // for 11 minutes (fullRun pause) between two samples.  With stallGap 90 s
+    // the pace right after the stop is the running pace up to the 90 s kept
+    // of the gap; without it the stop is inside the window and the ETA is
+    // several times too long.
+    const double pace = 0.45 / 3600.0;
+    dem::ProgressEstimate with(2.0, 13.0, 600.0, 90.0), without(2.0, 13.0, 600.0);
+    double wall = 0.0, t = 2.0;
+    for (int k = 0; k < 30; ++k) {
+        wall += 30.0;
+        t += 30.0 * pace;
+        with.add(wall, t);
+        without.add(wall, t);
+    }
+    wall += 660.0;  // stopped: no sample, no progress
+    for (int k = 0; k < 4; ++k) {
+        wall += 30.0;
+        t += 30.0 * pace;
+        with.add(wall, t);
+        without.add(wall, t);
+    }
+    const double expected = (13.0 - t) / pace;
+    // The window's 600 s hold the 90 s kept of the gap, in which the run
+    // advanced one interval (30 s of progress): 540 s of progress in 600 s.
+    EXPECT_NEAR(with.secondsLeft(), expected * 600.0 / 540.0, 1e-6 * expected);
+    EXPECT_GT(without.secondsLeft(), 2.0 * expected);
+    // A gap below stallGap is not a stop: the steady estimate is exact.
+    dem::ProgressEstimate steady(2.0, 13.0, 600.0, 90.0);
+    wall = 0.0;
+    t = 2.0;
+    for (int k = 0; k < 40; ++k) steady.add(wall += 80.0, t += 80.0 * pace);
+    EXPECT_NEAR(steady.secondsLeft(), (13.0 - t) / pace, 1e-6 * (13.0 - t) / pace);
+}
+
 TEST(ProgressEstimate, ThePaceFollowsAChangeWithinTheWindow) {
     // A run that slows to half its pace (e.g. the wet bed): after one window
     // at the new pace the estimate is the new pace's.

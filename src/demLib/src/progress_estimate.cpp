@@ -4,13 +4,15 @@
 
 namespace dem {
 
-ProgressEstimate::ProgressEstimate(double simulatedStart, double end, double window)
-    : end_(end), window_(window) {
+ProgressEstimate::ProgressEstimate(double simulatedStart, double end, double window, double stallGap)
+    : end_(end), window_(window), stallGap_(stallGap) {
     samples_.push_back({0.0, simulatedStart});
 }
 
 void ProgressEstimate::add(double wall, double simulated) {
-    samples_.push_back({wall, simulated});
+    if (stallGap_ > 0.0 && wall - lastWall_ > stallGap_) stalled_ += wall - lastWall_ - stallGap_;
+    lastWall_ = wall;
+    samples_.push_back({wall - stalled_, simulated});
     // Keep the newest sample at least `window` old, so the pace always spans
     // the window once the run is that long.
     while (samples_.size() > 2 && samples_.back().wall - samples_[1].wall >= window_) samples_.pop_front();
