@@ -33,9 +33,9 @@ Foam::diefill::progressReport::progressReport
     reportInterval_(reportInterval),
     clock_(),
     lastReport_(0),
-    // A gap of three report intervals between reports is a stop (fullRun
-    // pause): left out of the pace, so the ETA is right again at once.
-    estimate_(runTime.value(), runTime.endTime().value(), 600, 3*reportInterval)
+    // A gap of more than three report intervals between reports is a stop
+    // (fullRun pause): left out of the pace, so the ETA is right at once.
+    estimate_(runTime.value(), runTime.endTime().value(), 600, reportInterval)
 {}
 
 

@@ -97,9 +97,9 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
     }
     wallStart_ = lastProgress_ = std::chrono::steady_clock::now();
     stepsAtStart_ = simulation_->stepCount();
-    // A gap of three report intervals between progress lines is a stop (the
-    // engine returns every 100 steps at most, seconds even on large beds).
-    estimate_ = ProgressEstimate(startTime_, setup_.endTime, 600.0, 3.0 * options_.progressInterval);
+    // A gap of more than three report intervals between progress lines is a
+    // stop (the engine returns every 100 steps at most, seconds even on large beds).
+    estimate_ = ProgressEstimate(startTime_, setup_.endTime, 600.0, options_.progressInterval);
 }
 
 void CaseRunner::readRunnerState(const std::string& restartFile) {

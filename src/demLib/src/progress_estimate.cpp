@@ -4,13 +4,14 @@
 
 namespace dem {
 
-ProgressEstimate::ProgressEstimate(double simulatedStart, double end, double window, double stallGap)
-    : end_(end), window_(window), stallGap_(stallGap) {
+ProgressEstimate::ProgressEstimate(double simulatedStart, double end, double window, double sampleInterval)
+    : end_(end), window_(window), sampleInterval_(sampleInterval) {
     samples_.push_back({0.0, simulatedStart});
 }
 
 void ProgressEstimate::add(double wall, double simulated) {
-    if (stallGap_ > 0.0 && wall - lastWall_ > stallGap_) stalled_ += wall - lastWall_ - stallGap_;
+    const double gap = wall - lastWall_;
+    if (sampleInterval_ > 0.0 && gap > 3.0 * sampleInterval_) stalled_ += gap - sampleInterval_;
     lastWall_ = wall;
     samples_.push_back({wall - stalled_, simulated});
     // Keep the newest sample at least `window` old, so the pace always spans

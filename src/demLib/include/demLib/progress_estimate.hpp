@@ -18,11 +18,12 @@ class ProgressEstimate {
 public:
     // simulatedStart: the simulated time the run starts (or continues) from;
     // end: the simulated time it runs to; window: wall seconds of the pace.
-    // stallGap (0: off): a gap between two samples longer than this is a stop
-    // (the process was paused: it printed nothing), and the wall time beyond
-    // stallGap is left out of the pace; so a paused run's ETA is right at
-    // once, instead of only after the pause has left the window.
-    ProgressEstimate(double simulatedStart, double end, double window = 600.0, double stallGap = 0.0);
+    // sampleInterval (0: off): the wall seconds between samples of a running
+    // process.  A gap of more than three of them is a stop (the process was
+    // paused and printed nothing); all of it but one interval is left out of
+    // the pace, so a paused run's ETA is right at once instead of only after
+    // the pause has left the window.
+    ProgressEstimate(double simulatedStart, double end, double window = 600.0, double sampleInterval = 0.0);
 
     // A sample: wall seconds since the run started, simulated time reached.
     void add(double wall, double simulated);
@@ -40,7 +41,7 @@ private:
     struct Sample {
         double wall, simulated;
     };
-    double end_, window_, stallGap_;
+    double end_, window_, sampleInterval_;
     double lastWall_ = 0.0;  // wall time of the newest sample as given
     double stalled_ = 0.0;   // wall seconds left out (stops)
     std::deque<Sample> samples_;
