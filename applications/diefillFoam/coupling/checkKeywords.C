@@ -1,62 +1,10 @@
 #include "checkKeywords.H"
 #include "error.H"
 
-#include <algorithm>
+#include "demLib/dictionary.hpp"
+
+#include <string>
 #include <vector>
-
-namespace
-{
-
-// Levenshtein distance (insertions, deletions, substitutions).
-std::size_t editDistance(const std::string& a, const std::string& b)
-{
-    std::vector<std::size_t> row(b.size() + 1);
-    for (std::size_t j = 0; j <= b.size(); ++j)
-    {
-        row[j] = j;
-    }
-    for (std::size_t i = 1; i <= a.size(); ++i)
-    {
-        std::size_t diagonal = row[0];
-        row[0] = i;
-        for (std::size_t j = 1; j <= b.size(); ++j)
-        {
-            const std::size_t above = row[j];
-            row[j] = std::min
-            ({
-                row[j] + 1,
-                row[j - 1] + 1,
-                diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)
-            });
-            diagonal = above;
-        }
-    }
-    return row[b.size()];
-}
-
-} // End anonymous namespace
-
-
-Foam::word Foam::diefill::closestWord
-(
-    const word& misspelt,
-    const wordList& accepted
-)
-{
-    const std::size_t limit = std::max<std::size_t>(2, misspelt.size()/3);
-    word best;
-    std::size_t bestDistance = limit + 1;
-    for (const word& w : accepted)
-    {
-        const std::size_t d = editDistance(misspelt, w);
-        if (d < bestDistance)
-        {
-            best = w;
-            bestDistance = d;
-        }
-    }
-    return best;
-}
 
 
 void Foam::diefill::checkKeywords
@@ -72,7 +20,12 @@ void Foam::diefill::checkKeywords
         {
             continue;
         }
-        const word suggestion = closestWord(key, known);
+        // demLib's "did you mean", the same as for demProperties.
+        // (a word: OpenFOAM's streams print a std::string in quotes)
+        const word suggestion
+        (
+            dem::closestWord(key, std::vector<std::string>(known.begin(), known.end()))
+        );
         // A sub-dictionary is named file.block: the file is the part
         // before the first dot of the last path component.
         std::string file = dict.name();

@@ -71,21 +71,6 @@ std::size_t editDistance(const std::string& a, const std::string& b) {
     return d[n][m];
 }
 
-// The closest candidate if it is plausibly a typo of `word` (at most a third
-// of its letters wrong, at least one allowed), else "".  Ties go to the
-// candidate of the same length ("epsd3" -> "epsd2", not "epsd").
-std::string closest(const std::string& word, const std::vector<std::string>& candidates) {
-    auto lengthGap = [&](const std::string& c) { return c.size() > word.size() ? c.size() - word.size() : word.size() - c.size(); };
-    std::string best;
-    std::size_t bestDistance = std::numeric_limits<std::size_t>::max();
-    for (const auto& c : candidates) {
-        const std::size_t d = editDistance(word, c);
-        if (d < bestDistance || (d == bestDistance && lengthGap(c) < lengthGap(best))) { bestDistance = d; best = c; }
-    }
-    if (best.empty()) return "";
-    const std::size_t allowed = std::max<std::size_t>(1, std::max(word.size(), best.size()) / 3);
-    return bestDistance <= allowed ? best : "";
-}
 
 // ---------------------------------------------------------------- tokenizer
 enum class TokenKind {
@@ -229,6 +214,22 @@ std::string quoteShown(const Value& v) {
 }
 
 }  // namespace
+
+// The closest candidate if it is plausibly a typo of `word` (at most a third
+// of its letters wrong, at least one allowed), else "".  Ties go to the
+// candidate of the same length ("epsd3" -> "epsd2", not "epsd").
+std::string closestWord(const std::string& word, const std::vector<std::string>& candidates) {
+    auto lengthGap = [&](const std::string& c) { return c.size() > word.size() ? c.size() - word.size() : word.size() - c.size(); };
+    std::string best;
+    std::size_t bestDistance = std::numeric_limits<std::size_t>::max();
+    for (const auto& c : candidates) {
+        const std::size_t d = editDistance(word, c);
+        if (d < bestDistance || (d == bestDistance && lengthGap(c) < lengthGap(best))) { bestDistance = d; best = c; }
+    }
+    if (best.empty()) return "";
+    const std::size_t allowed = std::max<std::size_t>(1, std::max(word.size(), best.size()) / 3);
+    return bestDistance <= allowed ? best : "";
+}
 
 // ------------------------------------------------------------------- parser
 // Recursive descent over the tokens of one file; "#include" starts a parser
@@ -460,7 +461,7 @@ const Dictionary::Entry& Dictionary::require(const std::string& key, const std::
         std::vector<std::string> unread;
         for (const auto& entry : entries_)
             if (!entry.used) unread.push_back(entry.name);
-        const std::string suggestion = closest(key, unread);
+        const std::string suggestion = closestWord(key, unread);
         std::string hint;
         if (!suggestion.empty())
             hint = "; found '" + suggestion + "' on line " + std::to_string(find(suggestion)->line) +
@@ -701,7 +702,7 @@ std::string Dictionary::getChoice(const std::string& key, const std::vector<std:
     if (isWord && std::find(accepted.begin(), accepted.end(), v.text) != accepted.end()) return v.text;
     std::string message = at(e.file, e.line) + "keyword '" + scope_ + "/" + key + "': ";
     if (!isWord) throw InputError(message + "expected " + expected + ", got " + quoteShown(v));
-    const std::string suggestion = closest(v.text, accepted);
+    const std::string suggestion = closestWord(v.text, accepted);
     throw InputError(message + "unknown value '" + v.text + "'; expected " + expected +
                      (suggestion.empty() ? "" : " (did you mean '" + suggestion + "'?)"));
 }
@@ -713,7 +714,7 @@ void Dictionary::collectUnused(std::vector<std::string>& messages) const {
             if (e.value.kind == Value::Kind::Dict) e.value.dict->collectUnused(messages);
             continue;
         }
-        const std::string suggestion = closest(e.name, accepted_);
+        const std::string suggestion = closestWord(e.name, accepted_);
         messages.push_back(at(e.file, e.line) + "unknown keyword '" + e.name + "' in '" + scope_ + "'; " +
                            (suggestion.empty() ? "" : "did you mean '" + suggestion + "'? ") +
                            (accepted_.empty() ? "no keywords are read from '" + scope_ + "'"

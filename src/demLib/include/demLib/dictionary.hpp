@@ -19,6 +19,12 @@
 
 namespace dem {
 
+// The candidate closest to `word` if it is plausibly a typo of it (edit
+// distance with adjacent swaps, case-insensitive, at most a third of its
+// letters wrong, at least one), else "": the "did you mean" of every keyword
+// and value check (also diefillFoam's checkKeywords).
+std::string closestWord(const std::string& word, const std::vector<std::string>& candidates);
+
 class Dictionary {
 public:
     // An empty dictionary named `scopeName`, read from nowhere.
