@@ -495,4 +495,20 @@ TEST(CoarseGrain, FactorAndValidation) {
     EXPECT_THROW(dem::validateCoarseGrainSettings({0.5, 2.0}), dem::InputError);
     EXPECT_THROW(dem::validateCoarseGrainSettings({2.0, 4.0}), dem::InputError);
     EXPECT_NO_THROW(dem::validateCoarseGrainSettings({5.0, dem::paperCapillaryExponent}));
+    // Each error names where its own value came from, and prints it as given.
+    auto messageOf = [](const dem::CoarseGrainSettings& s) {
+        try {
+            dem::validateCoarseGrainSettings(s, "FACTOR-SOURCE", "EXPONENT-SOURCE");
+        } catch (const dem::InputError& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    const std::string factor = messageOf({-5.0, 2.0});
+    EXPECT_NE(factor.find("FACTOR-SOURCE: expected a number >= 1"), std::string::npos) << factor;
+    EXPECT_NE(factor.find("got -5"), std::string::npos) << factor;
+    EXPECT_EQ(factor.find("-5.000000"), std::string::npos) << factor;
+    const std::string exponent = messageOf({2.0, 4.0});
+    EXPECT_NE(exponent.find("EXPONENT-SOURCE: expected a number in [0, 3]"), std::string::npos) << exponent;
+    EXPECT_EQ(exponent.find("FACTOR-SOURCE"), std::string::npos) << exponent;
 }

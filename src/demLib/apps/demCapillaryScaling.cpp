@@ -110,7 +110,7 @@ Options parseOptions(int argc, char** argv, bool& helpRequested) {
     if (!(options.gapFraction >= 0.0 && options.gapFraction < 1.0))
         throw dem::InputError("command line: option '-gapFraction' expects a number in [0, 1)");
     dem::validateCapillaryParameters({options.surfaceTension, options.contactAngle}, "command line");
-    dem::validateCoarseGrainSettings({1.0, options.kappa}, "command line");
+    dem::validateCoarseGrainSettings({1.0, options.kappa}, "command line", "command line: option '-kappa'");
     return options;
 }
 

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <sstream>
 
 #include "demLib/error.hpp"
 #include "demLib/triangle_mesh.hpp"
@@ -253,17 +252,10 @@ CaseSetup readCaseSetup(const Dictionary& root, const std::string& caseDir) {
 
     if (root.has("coarseGrain")) {
         const Dictionary& cg = root.subDict("coarseGrain");
-        // Each value checked against its own keyword (file, line, what is expected).
         c.coarseGrain.factor = cg.get<double>("factor");
-        if (!(c.coarseGrain.factor >= 1.0) || !std::isfinite(c.coarseGrain.factor)) {
-            std::ostringstream m;
-            m << cg.describe("factor") << ": expected a number >= 1 (1: no coarse graining), got "
-              << c.coarseGrain.factor;
-            throw InputError(m.str());
-        }
-        c.coarseGrain.capillaryExponent =
-            cg.has("capillaryExponent") ? cg.getInRange("capillaryExponent", 0.0, 3.0) : paperCapillaryExponent;
-        validateCoarseGrainSettings(c.coarseGrain, cg.describe("factor"));
+        c.coarseGrain.capillaryExponent = cg.getOrDefault<double>("capillaryExponent", paperCapillaryExponent);
+        // Each value's error names its own keyword.
+        validateCoarseGrainSettings(c.coarseGrain, cg.describe("factor"), cg.describe("capillaryExponent"));
     }
 
     if (root.has("cohesion")) {

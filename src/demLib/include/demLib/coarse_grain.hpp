@@ -36,9 +36,12 @@ struct CoarseGrainSettings {
     double capillaryExponent = paperCapillaryExponent;  // κ
 };
 
-// Throws InputError (keyword 'coarseGrainFactor' / 'capillaryExponent') for
-// l < 1, non-finite values, or κ outside [0, 3].
-void validateCoarseGrainSettings(const CoarseGrainSettings& settings, const std::string& source = "coarse grain");
+// Throws InputError for l < 1 or not finite, or κ outside [0, 3], naming
+// where the value came from: `factorSource` / `exponentSource` (a file, line
+// and keyword, or a command-line option).
+void validateCoarseGrainSettings(const CoarseGrainSettings& settings,
+                                 const std::string& factorSource = "coarse-grain factor",
+                                 const std::string& exponentSource = "capillary exponent of eq 9");
 
 // l^κ, the coarse grain factor (CGF) of eq 9.
 double coarseGrainCapillaryFactor(double l, double kappa);
