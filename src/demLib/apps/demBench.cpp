@@ -53,6 +53,7 @@
 #endif
 
 #include "demLib/case_setup.hpp"
+#include "demLib/command_line.hpp"
 #include "demLib/communicator.hpp"
 #include "demLib/error.hpp"
 #include "demLib/ghost_exchange.hpp"
@@ -117,9 +118,8 @@ struct Options {
     double number(const std::string& k, double fallback) const {
         if (!has(k)) return fallback;
         const std::string& text = values.at(k);
-        char* end = nullptr;
-        const double v = std::strtod(text.c_str(), &end);
-        if (text.empty() || *end != '\0' || !std::isfinite(v))
+        double v = 0.0;
+        if (!dem::parseNumber(text, v))
             throw dem::InputError("option -" + k + " expects a number, got '" + text + "'");
         return v;
     }

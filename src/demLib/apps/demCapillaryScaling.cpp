@@ -15,6 +15,7 @@
 
 #include "demLib/capillary_force.hpp"
 #include "demLib/coarse_grain.hpp"
+#include "demLib/command_line.hpp"
 #include "demLib/error.hpp"
 #include "demLib/liquid_bridges.hpp"
 
@@ -58,9 +59,8 @@ void printUsage(std::ostream& out) {
 }
 
 double parseNumber(const std::string& keyword, const char* text) {
-    char* end = nullptr;
-    const double value = std::strtod(text, &end);
-    if (end == text || *end != '\0' || !std::isfinite(value))
+    double value = 0.0;
+    if (!dem::parseNumber(text, value))
         throw dem::InputError("command line: option '" + keyword + "' expects a number, got '" + text + "'");
     return value;
 }

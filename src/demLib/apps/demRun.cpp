@@ -16,6 +16,7 @@
 #endif
 
 #include "demLib/case_runner.hpp"
+#include "demLib/command_line.hpp"
 #include "demLib/error.hpp"
 #include "demLib/version.hpp"
 
@@ -59,14 +60,6 @@ void usage(std::ostream& out) {
            "docs/case-reference.md.  Exit status: 0 on success, 1 on bad input, 2 on a runtime failure.\n";
 }
 
-// The whole argument as a number, or nothing (atof read "2x" as 2 and "abc" as 0).
-bool parseNumber(const std::string& text, double& value) {
-    if (text.empty()) return false;
-    char* end = nullptr;
-    value = std::strtod(text.c_str(), &end);
-    return *end == '\0' && std::isfinite(value);
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -93,14 +86,14 @@ int main(int argc, char** argv) {
         } else if (a == "-threads") {
             const std::string text = value("a number of threads");
             double n = 0.0;
-            if (!parseNumber(text, n) || n < 1.0 || n != std::floor(n) || n > 4096.0) {
+            if (!dem::parseNumber(text, n) || n < 1.0 || n != std::floor(n) || n > 4096.0) {
                 std::cerr << "demRun: -threads expects a positive integer, got '" << text << "'\n";
                 return 1;
             }
             threads = static_cast<int>(n);
         } else if (a == "-endTime") {
             const std::string text = value("a time in seconds");
-            if (!parseNumber(text, endTime) || !(endTime > 0.0)) {
+            if (!dem::parseNumber(text, endTime) || !(endTime > 0.0)) {
                 std::cerr << "demRun: -endTime expects a positive time in seconds, got '" << text << "'\n";
                 return 1;
             }

@@ -15,6 +15,7 @@
 #include "demLib/bed_stability.hpp"
 #include "demLib/case_runner.hpp"
 #include "demLib/case_setup.hpp"
+#include "demLib/command_line.hpp"
 #include "demLib/error.hpp"
 #include "demLib/simulation.hpp"
 #include "demLib/version.hpp"
@@ -44,9 +45,8 @@ void usage(std::ostream& out) {
 
 // A finite number, or an InputError naming the option and what it expects.
 double number(const std::string& option, const std::string& text, const std::string& expected) {
-    char* end = nullptr;
-    const double v = std::strtod(text.c_str(), &end);
-    if (end == text.c_str() || *end != '\0' || !std::isfinite(v))
+    double v = 0.0;
+    if (!dem::parseNumber(text, v))
         throw dem::InputError("demStability: " + option + " expects " + expected + ", got '" + text + "'");
     return v;
 }
