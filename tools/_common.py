@@ -1,4 +1,5 @@
 """Shared helpers of the command-line scripts in tools/."""
+import argparse
 import os
 import sys
 
@@ -12,6 +13,15 @@ def frame_at(case, time=None):
     if time is None:
         return series.read_frame(entries[-1][1])
     return series.read_frame(min(entries, key=lambda e: abs(e[0] - time))[1])
+
+
+def argument_parser(doc):
+    """An argparse parser whose help is -help, as in OpenFOAM's and demLib's tools
+    (and -h, --help); argparse alone takes '-help' for '-h elp' and fails."""
+    parser = argparse.ArgumentParser(description=doc, add_help=False,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("-help", "-h", "--help", action="help", help="show this help and exit")
+    return parser
 
 
 def out_dir(case):

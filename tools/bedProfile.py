@@ -8,18 +8,17 @@ Heights are the highest particle top (centre height + radius) per bin (see
 docs/post-processing.md).  With -window (mm, along the line / from the axis) a line is
 fitted and its angle reported; -window auto takes the pile flank (80 %-20 % of the peak).
 Writes postProcessing/<N>.csv and <N>.png (N default 'bedProfile')."""
-import argparse
 import csv
 import os
 
 import numpy as np
 
-from _common import frame_at, out_dir, run_main
+from _common import argument_parser, frame_at, out_dir, run_main
 from diefillpost import plots, profile
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argument_parser(__doc__)
     ap.add_argument("-case", default=".")
     ap.add_argument("-time", type=float, default=None)
     g = ap.add_mutually_exclusive_group(required=True)

@@ -26,14 +26,13 @@ Heights are measured from the die base (z = -H).
 A run that has not reached the die opening yet (a long run looked at while it goes) gets
 fillRatio.png, sideView_latest.png, air.png and results.json with "state": "in progress" and
 the fill so far; the profile and the angles come once the run is past the opening."""
-import argparse
 import os
 import sys
 
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _common import out_dir, run_main  # noqa: E402
+from _common import argument_parser, out_dir, run_main  # noqa: E402
 from diefillpost import foamdict, plots, profile, results, series, summary  # noqa: E402
 
 
@@ -285,7 +284,7 @@ def report_before_opening(case, out, props, s, frames, poured, fill, opening, en
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argument_parser(__doc__)
     ap.add_argument("-case", default=".")
     ap.add_argument("-openingStart", type=float, default=None)
     ap.add_argument("-runTime", type=float, default=None, help="wall time of the run [s], for the summary")

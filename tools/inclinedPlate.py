@@ -11,7 +11,6 @@ Also the 'moved' fraction: mass off the plate or displaced more than D down the
 slope relative to the plate since the tilting started (shows the onset of sliding).
 Writes postProcessing/{slidFraction.csv, slidFraction.png, sideView_*.png,
 results.json, results.csv}."""
-import argparse
 import csv
 import os
 import sys
@@ -20,13 +19,13 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from diefillpost import foamdict, geometry, plate, plots, results, series, summary  # noqa: E402
-from _common import run_main  # noqa: E402
+from _common import argument_parser, run_main  # noqa: E402
 
 PAPER = {"start": 22.0, "at27": 0.35, "none_left": 37.0, "simulation50": 29.0}
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argument_parser(__doc__)
     ap.add_argument("-case", default=".")
     ap.add_argument("-plate", default="plate", help="name of the plate wall (type stl) in demProperties")
     ap.add_argument("-height", type=float, default=0.02, help="on-plate height limit above the top face [m]")

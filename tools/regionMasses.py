@@ -9,18 +9,17 @@ centre inside, as demLib's output/regions); the mass_<region> columns of
 dem/summary.csv are added as they are.  With -reference M (kg) the fill ratio
 mass/M is written too (e.g. M = the mass that fills the die).  Writes
 postProcessing/<N>.csv and <N>.png (N default 'regionMasses')."""
-import argparse
 import csv
 import os
 
 import numpy as np
 
-from _common import out_dir, run_main
+from _common import argument_parser, out_dir, run_main
 from diefillpost import geometry, plots, series, summary
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argument_parser(__doc__)
     ap.add_argument("-case", default=".")
     ap.add_argument("-box", nargs=7, action="append", default=[], metavar="V")
     ap.add_argument("-cylinder", nargs=10, action="append", default=[], metavar="V")

@@ -13,7 +13,6 @@ height (defaults 0.8 and 0.2: the rounded top and the toe are left out), or over
 [RA, RB] (mm) when -window is given.  The angle is atan|slope|; the same fit in
 each sector gives the spread.  Writes postProcessing/{profile.csv, reposeProfile.png,
 sideView.png, results.json, results.csv}."""
-import argparse
 import csv
 import os
 import sys
@@ -22,13 +21,13 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from diefillpost import foamdict, geometry, plots, profile, results, series, summary  # noqa: E402
-from _common import run_main  # noqa: E402
+from _common import argument_parser, run_main  # noqa: E402
 
 PAPER_ANGLE = 28.0
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argument_parser(__doc__)
     ap.add_argument("-case", default=".")
     ap.add_argument("-tube", default="tube", help="name of the lifted cylinder wall (gives the axis)")
     ap.add_argument("-binWidth", type=float, default=None, help="radial bin [m] (default: 1.5 mean diameters)")

@@ -5,15 +5,14 @@ projected on a vertical plane, coloured by height, speed or angular velocity.
     sideView.py -case DIR [-time T] [-color height|speed|omega] [-horizontal X Y Z] [-name N]
 
 Writes postProcessing/<N>.png (N default 'sideView_<time>')."""
-import argparse
 import os
 
-from _common import frame_at, out_dir, run_main
+from _common import argument_parser, frame_at, out_dir, run_main
 from diefillpost import plots
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argument_parser(__doc__)
     ap.add_argument("-case", default=".")
     ap.add_argument("-time", type=float, default=None)
     ap.add_argument("-color", choices=("height", "speed", "omega"), default="height")

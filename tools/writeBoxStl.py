@@ -5,14 +5,13 @@
 
 Used by the inclined-plate tutorial for its finite steel plate (a mesh wall is
 two-sided and has edges, unlike an infinite one-sided plane)."""
-import argparse
 import os
 import sys
 
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _common import run_main  # noqa: E402
+from _common import argument_parser, run_main  # noqa: E402
 
 
 def box_triangles(lo, hi):
@@ -40,7 +39,7 @@ def write_stl(path, triangles, name="box"):
 
 
 def main():
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argument_parser(__doc__)
     p.add_argument("out")
     p.add_argument("coords", type=float, nargs=6, metavar="X")
     p.add_argument("-name", default="box")

@@ -347,6 +347,20 @@ def missing_case_is_one_line_and_exit_1():
               f"(exit {r.returncode}, stderr {r.stderr.strip()[-300:]!r})")
 
 
+@test
+def help_option_of_every_tool():
+    # -help (OpenFOAM's and demRun's spelling), -h and --help print the usage and exit 0;
+    # argparse alone read '-help' as '-h elp' and failed with exit 2.
+    tools = sorted(f for f in os.listdir(os.path.join(ROOT, "tools")) if f.endswith(".py") and not f.startswith("_"))
+    check("the tools to ask for help", len(tools) >= 8, f"({', '.join(tools)})")
+    for script in tools:
+        for option in ("-help", "-h", "--help"):
+            r = subprocess.run([sys.executable, os.path.join(ROOT, "tools", script), option], capture_output=True, text=True)
+            check(f"{script} {option}: usage on stdout, exit 0",
+                  r.returncode == 0 and ("usage:" in r.stdout.lower()) and r.stderr == "",
+                  f"(exit {r.returncode}, stderr {r.stderr.strip()[-200:]!r})")
+
+
 import shutil  # noqa: E402
 
 shutil.rmtree(TMP, ignore_errors=True)
