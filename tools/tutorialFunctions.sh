@@ -7,6 +7,8 @@
 #                               first run) with the '// @quick ...' lines swapped in (-quick) and
 #                               'rolling <model>' set (-rolling)
 #   tutorial_run_demRun         demRun (or $DEMRUN) in the case (log.demRun), wall time in TUTORIAL_DEM_SECONDS
+#   tutorial_clean_args "$@"    Allclean's arguments: the usage from the caller's header on -help;
+#                               anything else stops it before a file is removed (exit 2)
 #   tutorial_clean              removes the results and restores constant/demProperties
 # Cases with air (diefillFoam; dieFilling):
 #   tutorial_swap_quick SRC DST  DST from SRC with the '// @quick ...' lines swapped in (-quick)
@@ -130,6 +132,16 @@ tutorial_prepare_air() {
 tutorial_run_diefillFoam() {
     [ -d dem/restart ] && [ -n "$(tutorial_air_times)" ] || rm -rf dem
     OMP_NUM_THREADS=$THREADS tutorial_timed_run diefillFoam log.diefillFoam _tutorial_diefillFoam
+}
+
+# Allclean deletes a case's results, so an option it does not know (a typo, or an
+# Allrun option given to it by mistake) must stop it before anything is removed.
+tutorial_clean_args() {
+    case "${1-}" in
+        '') ;;
+        -h|-help|--help) tutorial_usage; exit 0 ;;
+        *) echo "$(basename "$0"): unknown option '$1'; nothing removed" >&2; tutorial_usage >&2; exit 2 ;;
+    esac
 }
 
 tutorial_clean_air() {
