@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -45,6 +46,13 @@ private:
     std::streambuf* b_;
 };
 
+std::string utcNow() {
+    const std::time_t now = std::time(nullptr);
+    char text[32];
+    std::strftime(text, sizeof text, "%Y-%m-%d %H:%M:%S UTC", std::gmtime(&now));
+    return text;
+}
+
 void usage(std::ostream& out) {
     out << "Usage: demRun [OPTIONS]\n"
            "Runs a DEM-only diefill case (demLib " << dem::versionString << ").\n\n"
@@ -55,9 +63,10 @@ void usage(std::ostream& out) {
            "  -endTime T         stop at T seconds instead of the case's endTime\n"
            "  -quiet             no progress lines\n"
            "  -help              this text\n\n"
-           "Writes into the case: log.demRun, <output>/particles.xdmf (+ particles_*.h5; open the .xdmf in\n"
-           "ParaView), <output>/summary.csv, <output>/restart/restart_*.h5.  The input format is described in\n"
-           "docs/case-reference.md.  Exit status: 0 on success, 1 on bad input, 2 on a runtime failure.\n";
+           "Writes into the case: log.demRun (a run with -restart adds to it), <output>/particles.xdmf\n"
+           "(+ particles_*.h5; open the .xdmf in ParaView), <output>/summary.csv, <output>/restart/restart_*.h5.\n"
+           "The input format is described in docs/case-reference.md.  Exit status: 0 on success, 1 on bad\n"
+           "input, 2 on a runtime failure.\n";
 }
 
 }  // namespace
@@ -108,8 +117,14 @@ int main(int argc, char** argv) {
 #ifdef _OPENMP
     if (threads > 0) omp_set_num_threads(threads);
 #endif
+    // A continued run adds to the log of the run it continues (whose earlier part the
+    // restart file's results belong to); a new run starts a new log, as its results do.
     std::ofstream logFile;
-    if (std::filesystem::is_directory(caseDir)) logFile.open(std::filesystem::path(caseDir) / "log.demRun");
+    const bool continuing = !options.restartFrom.empty();
+    if (std::filesystem::is_directory(caseDir))
+        logFile.open(std::filesystem::path(caseDir) / "log.demRun", continuing ? std::ios::app : std::ios::trunc);
+    if (continuing && logFile.is_open())
+        logFile << "\n==== demRun -restart " << options.restartFrom << ": continued at " << utcNow() << "\n";
     TeeBuffer tee(std::cout.rdbuf(), logFile.is_open() ? logFile.rdbuf() : nullptr);
     std::ostream log(&tee);
     try {
