@@ -48,6 +48,9 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
         // Wetting happens after the step that reaches wettingTime and before that
         // step's output, so a restart file at or after it holds the water.
         wetted_ = wetted_ || setup_.wettingTime <= startTime_ + 1e-12;
+        // The file it was read from is this step's restart: finish() must not write it
+        // again (a run continued at its end would rewrite the one file it has).
+        lastRestartStep_ = simulation_->stepCount();
         log_ << "Continuing from restart file " << restart << " at t = " << startTime_ << " s, step "
              << simulation_->stepCount() << ", " << simulation_->particles().size() << " particles\n";
     }
@@ -63,6 +66,9 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
             if (kept.empty()) { kept.push_back(line); continue; }
             if (std::stod(line.substr(0, line.find(','))) <= startTime_ + 1e-12) kept.push_back(line);
         }
+        // A line at the restart time is this step's: finish() must not add it twice.
+        if (kept.size() > 1 && std::stod(kept.back().substr(0, kept.back().find(','))) >= startTime_ - 1e-12)
+            lastLogStep_ = simulation_->stepCount();
     }
     if (kept.empty()) {
         summary_.open(summaryPath, std::ios::trunc);
