@@ -3,10 +3,19 @@
 #   tutorial_parse_args "$@"    sets QUICK (0/1), ROLLING (cdt|epsd2|epsd|none or empty = as in the file),
 #                               THREADS (default 1: on a shared 2-core machine one thread is several
 #                               times faster than two); prints the usage from the caller's header on -help
-#   tutorial_prepare            constant/demProperties from constant/demProperties.orig (saved on the
+#   tutorial_prepare [EXTRA]    constant/demProperties from constant/demProperties.orig (saved on the
 #                               first run) with the '// @quick ...' lines swapped in (-quick) and
-#                               'rolling <model>' set (-rolling)
-#   tutorial_run_demRun         demRun (or $DEMRUN) in the case (log.demRun), wall time in TUTORIAL_DEM_SECONDS
+#                               'rolling <model>' set (-rolling); first checks the case with
+#                               tutorial_guard (VARIANT: "quick|full, rolling MODEL" + EXTRA)
+#   tutorial_guard              stops Allrun (exit 2) before it writes anything when the case holds
+#                               results of another variant or of other inputs, or when the generated
+#                               constant/demProperties was edited by hand (Allrun would overwrite it)
+#   tutorial_record             writes constant/runRecord (variant, checksums of demProperties.orig and of
+#                               the generated demProperties) just before the solver runs
+#   tutorial_run_demRun         demRun (or $DEMRUN) in the case (log.demRun); continues from the newest
+#                               restart file when there is one (same variant and inputs: tutorial_guard);
+#                               wall time in TUTORIAL_DEM_SECONDS, and TUTORIAL_RUNTIME_ARGS = (-runTime S)
+#                               for the post-processing when the run went from its start in one piece
 #   tutorial_clean_args "$@"    Allclean's arguments: the usage from the caller's header on -help;
 #                               anything else stops it before a file is removed (exit 2)
 #   tutorial_clean              removes the results and restores constant/demProperties
@@ -16,7 +25,7 @@
 #                               subsetMesh, createPatch) and 0/ from 0.orig/; when time folders
 #                               and the mesh exist already, keeps them: the run continues
 #   tutorial_run_diefillFoam    diefillFoam in the case (log.diefillFoam), wall time in
-#                               TUTORIAL_DEM_SECONDS
+#                               TUTORIAL_DEM_SECONDS (and TUTORIAL_RUNTIME_ARGS, as for demRun)
 #   tutorial_clean_air          removes the mesh, 0/, the time folders and the air's outputs
 
 # The Allrun scripts cd to their own folder first, so a relative $0 given from elsewhere
@@ -63,8 +72,54 @@ tutorial_swap_quick() {
     fi
 }
 
+# The variant a run is: setting, rolling model (as given, or the file's) and the caller's extra.
+tutorial_variant() {
+    local src=constant/demProperties rolling=$ROLLING
+    [ -f "$src.orig" ] && src=$src.orig
+    [ -n "$rolling" ] || rolling=$(sed -n -E 's#.*contactModel[^}]*rolling ([a-z0-9]+);.*#\1#p' "$src" | head -1)
+    echo "$([ "$QUICK" = 1 ] && echo quick || echo full), rolling $rolling${1-}"
+}
+
+_tutorial_md5() { md5sum < "$1" | cut -d' ' -f1; }
+_tutorial_recorded() { sed -n "s/^$1 //p" constant/runRecord 2> /dev/null; }
+
+# Results of a run: DEM output or air time folders.
+tutorial_has_results() { [ -f dem/summary.csv ] || [ -f dem/restart/latest ] || [ -n "$(tutorial_air_times)" ]; }
+
+tutorial_guard() {
+    local props=constant/demProperties me recorded
+    me=$(basename "$0")
+    [ -f constant/runRecord ] || return 0     # never run, or cleaned, or run before the record existed
+    if [ -f "$props.orig" ] && [ "$(_tutorial_md5 "$props")" != "$(_tutorial_recorded generated)" ]; then
+        echo "$me: constant/demProperties was changed after Allrun wrote it from constant/demProperties.orig," \
+             "and Allrun would overwrite the change; nothing done. Make the change in constant/demProperties.orig" \
+             "(Allrun's source, with the '// @quick' lines), or run ./Allclean to drop it." >&2
+        exit 2
+    fi
+    tutorial_has_results || return 0
+    recorded=$(_tutorial_recorded variant)
+    if [ "$recorded" != "$VARIANT" ]; then
+        echo "$me: this case holds the results of a '$recorded' run, and this is a '$VARIANT' run: Allrun would" \
+             "mix or delete them; nothing done. Run ./Allclean first, or run in a fresh copy of the tutorial." >&2
+        exit 2
+    fi
+    if [ -f "$props.orig" ] && [ "$(_tutorial_md5 "$props.orig")" != "$(_tutorial_recorded source)" ]; then
+        echo "$me: constant/demProperties.orig was changed after this case's results were computed: Allrun" \
+             "would continue them with other inputs; nothing done. Run ./Allclean first (the results go)," \
+             "or run in a fresh copy of the case." >&2
+        exit 2
+    fi
+}
+
+tutorial_record() {
+    printf 'variant %s\nsource %s\ngenerated %s\n' "$VARIANT" "$(_tutorial_md5 constant/demProperties.orig)" \
+        "$(_tutorial_md5 constant/demProperties)" > constant/runRecord
+}
+
 tutorial_prepare() {
     local props=constant/demProperties
+    VARIANT=$(tutorial_variant "${1-}")
+    tutorial_guard
     [ -f "$props.orig" ] || cp "$props" "$props.orig"
     tutorial_swap_quick "$props.orig" "$props"
     if [ -n "$ROLLING" ]; then
@@ -92,12 +147,23 @@ tutorial_timed_run() {
 }
 
 # demRun writes log.demRun itself (with its progress lines and ETA)
-_tutorial_demRun() { "${DEMRUN:-demRun}" -case "$PWD" -threads "$THREADS" > /dev/null 2>&1; }
+_tutorial_demRun() { "${DEMRUN:-demRun}" -case "$PWD" -threads "$THREADS" ${TUTORIAL_RESTART_ARGS[@]+"${TUTORIAL_RESTART_ARGS[@]}"} > /dev/null 2>&1; }
 _tutorial_diefillFoam() { diefillFoam >> log.diefillFoam 2>&1; }
 
+# A stopped run (or a finished one: then only the post-processing runs again) goes on from its
+# newest restart file; tutorial_guard has made sure it is this variant's, with these inputs.
 tutorial_run_demRun() {
-    rm -rf dem log.demRun
+    TUTORIAL_RESTART_ARGS=()
+    if [ -f dem/restart/latest ]; then
+        echo "    continuing from the newest restart file, dem/restart/$(cat dem/restart/latest) (./Allclean to start afresh)"
+        TUTORIAL_RESTART_ARGS=(-restart latest)
+    else
+        rm -rf dem log.demRun
+    fi
+    tutorial_record
     tutorial_timed_run demRun log.demRun _tutorial_demRun
+    TUTORIAL_RUNTIME_ARGS=()
+    [ -n "${TUTORIAL_RESTART_ARGS[*]}" ] || TUTORIAL_RUNTIME_ARGS=(-runTime "$TUTORIAL_DEM_SECONDS")
 }
 
 # Time folders of the air after 0, in order
@@ -130,8 +196,12 @@ tutorial_prepare_air() {
 }
 
 tutorial_run_diefillFoam() {
-    [ -d dem/restart ] && [ -n "$(tutorial_air_times)" ] || rm -rf dem
+    local continued=0
+    if [ -d dem/restart ] && [ -n "$(tutorial_air_times)" ]; then continued=1; else rm -rf dem; fi
+    tutorial_record
     OMP_NUM_THREADS=$THREADS tutorial_timed_run diefillFoam log.diefillFoam _tutorial_diefillFoam
+    TUTORIAL_RUNTIME_ARGS=()
+    [ "$continued" = 1 ] || TUTORIAL_RUNTIME_ARGS=(-runTime "$TUTORIAL_DEM_SECONDS")
 }
 
 # Allclean deletes a case's results, so an option it does not know (a typo, or an
@@ -152,7 +222,7 @@ tutorial_clean_air() {
 }
 
 tutorial_clean() {
-    rm -rf dem postProcessing log.* constant/setting
+    rm -rf dem postProcessing log.* constant/setting constant/runRecord
     [ -f constant/demProperties.orig ] && mv constant/demProperties.orig constant/demProperties
     return 0
 }
