@@ -123,8 +123,11 @@ def main(argv):
             for l, got, want in zip(scales, fixed_gap, ratios(gap)):
                 close(f"l={l:g} ratioFixedVolumeFixedGap (gap {gap / R:.4f} R)", got, want, 1e-6)
             close("slope of the fixed-volume fixed-gap reading", line_fit(scales, fixed_gap)[0], 0.95, 1e-6)
+            print(f"fixed-volume fixed-gap reading checked: gap {gap / R:.4f} R gives the slope 0.95")
         elif any(fixed_gap):
             failures.append("ratioFixedVolumeFixedGap is filled, but no gap gives the slope 0.95")
+        else:
+            print("fixed-volume fixed-gap reading: no gap gives the slope 0.95 here; the column is zero, as it must be")
 
     # Printed power-law exponent of the paper's own line over l = 1..20.
     xs = [math.log(l) for l in range(1, 21)]

@@ -69,7 +69,13 @@ TEST(SpatialOrder, LongestAxisIsSlowestShortestFastest) {
 TEST(SpatialOrder, ScatteredParticlesDoNotBlowUpTheGrid) {
     std::vector<Vec3> x = {Vec3(0, 0, 0), Vec3(1e3, 1e3, 1e3), Vec3(1e-3, 0, 0)};
     const std::vector<int> order = dem::spatialOrder(x, 1e-3);  // 1e18 cells without the cap
-    EXPECT_EQ(order.size(), 3u);
+    ASSERT_EQ(order.size(), 3u);
+    std::vector<int> sorted = order;
+    std::sort(sorted.begin(), sorted.end());
+    EXPECT_EQ(sorted, (std::vector<int>{0, 1, 2}));  // a permutation
+    // The two particles 1 mm apart are neighbours in the order, the far one at an end.
+    const auto far = std::find(order.begin(), order.end(), 1) - order.begin();
+    EXPECT_TRUE(far == 0 || far == 2) << far;
 }
 
 TEST(ParticleWallCandidates, ListsStaticWallsWithinReachAndAllMovingWalls) {

@@ -554,7 +554,6 @@ void expectClosedRollingCycleLeavesTheSpringUnloaded() {
         for (int k = 0; k < n; ++k) torque = ContactLaw<Rolling>::evaluate(kin, props, history).rollingTorque;
         return torque;
     };
-    double oldFormTorque = 0.0;  // the LIGGGHTS torque form, for contrast
     for (int cycle = 1; cycle <= 20; ++cycle) {
         SCOPED_TRACE("cycle " + std::to_string(cycle));
         roll(overlap1, omega, steps);
@@ -570,10 +569,9 @@ void expectClosedRollingCycleLeavesTheSpringUnloaded() {
         EXPECT_LT(std::abs(torque.y()), 1e-9 * kr1 * a);
         EXPECT_EQ(torque.x(), 0.0);
         EXPECT_EQ(torque.z(), 0.0);
-        oldFormTorque += -kr1 * a + kr2 * a;
     }
-    // What the torque form would hold after the cycles: 20 (kr2 - kr1) a.
-    EXPECT_GT(std::abs(oldFormTorque), 20.0 * 0.9 * kr1 * a);
+    // (LIGGGHTS keeps the torque, incremented by -kr dtheta with the current kr: each
+    // cycle would leave (kr2 - kr1) a in it, 20 (kr2 - kr1) a > 18 kr1 a after these.)
 }
 
 TEST(RollingEPSD2, ClosedRollingCycleUnderChangingOverlapLeavesTheSpringUnloaded) {

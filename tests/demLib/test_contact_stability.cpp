@@ -183,10 +183,9 @@ TEST(ContactStability, ContactNumberAroundASphere) {
         }
         below = next;
     }
-    // Twelve around an equal sphere touch it without overlapping each other:
-    // the icosahedron's neighbouring vertices are 63.43 deg apart, more than
-    // the 60 deg that two touching equal spheres subtend.
-    EXPECT_GT(std::acos(1.0 / std::sqrt(5.0)), 2.0 * std::asin(0.5));
+    // (Twelve around an equal sphere touch it without overlapping each other: the
+    // icosahedron's neighbouring vertices are acos(1/sqrt 5) = 63.43 deg apart, more
+    // than the 60 deg that two touching equal spheres subtend.)
 }
 
 // The wet-bed cluster of a grain among equal ones: twelve contacts in an

@@ -253,7 +253,7 @@ def fluidisation(args):
           f"{100*err_plateau:+.2f} % (tolerance 3 %; the weight without buoyancy would be "
           f"{n*volume*rho_p*g/area:.4f} Pa)")
     print(f"    minimum fluidisation velocity (fit meets plateau) {u_mf:.4f} m/s, Ergun estimate "
-          f"{u_ergun:.4f} m/s: {100*err_umf:+.2f} % (tolerance 10 %)")
+          f"{u_ergun:.4f} m/s: {100*err_umf:+.2f} % (tolerance 5 %)")
     # Quasi-steady: over the plateau window the bed's momentum changes by less
     # than 1 % of its weight times the window
     log = open(f"{case}/log.diefillFoam").read()
@@ -293,7 +293,10 @@ def fluidisation(args):
         # fraction of the pressure force other than the particles' complement,
         # e.g. localMin, missed by 4.6 %; docs/coupling.md).
         return abs(closure) < 1e-2 and abs(exchange) < 1e-2
-    return abs(err_umf) < 0.10 and abs(err_fixed) < 0.10
+    # u_mf within 5 % (measured +0.6 % serial, +2.7 % parallel; the localMin face void
+    # fraction of the pressure force, rejected in docs/coupling.md, gave +8.4 %); the fixed
+    # bed within 10 % (measured -7.1 % / -8.4 %: the bed's porosity varies between layers).
+    return abs(err_umf) < 0.05 and abs(err_fixed) < 0.10
 
 
 def bed_support(case, log, steps, t0, t1):
