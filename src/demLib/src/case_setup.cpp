@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
 
 #include "demLib/error.hpp"
 #include "demLib/triangle_mesh.hpp"
@@ -18,6 +21,17 @@ constexpr double pi = 3.14159265358979323846;
 std::string resolve(const std::string& caseDir, const std::string& file) {
     const fs::path p(file);
     return p.is_absolute() ? file : (fs::path(caseDir) / p).string();
+}
+
+// MemAvailable of /proc/meminfo in bytes; 0 where it cannot be read (not Linux).
+double availableMemoryBytes() {
+    std::ifstream in("/proc/meminfo");
+    std::string key;
+    double kilobytes = 0.0;
+    std::string unit;
+    while (in >> key >> kilobytes >> unit)
+        if (key == "MemAvailable:") return kilobytes * 1024.0;
+    return 0.0;
 }
 
 [[noreturn]] void invalid(const Dictionary& d, const std::string& key, const std::string& expected) {
@@ -145,6 +159,36 @@ std::shared_ptr<SizeDistribution> readDistribution(const Dictionary& d, double s
         s.describe("classes")));
 }
 
+// Bounds on the number of particles asked for, checked before the population is
+// drawn: a mistyped mass (1e3 for 1e-3 kg) asks for hundreds of millions of
+// particles, gigabytes of diameters before the placement could refuse them.
+void checkPopulationSize(const Dictionary& d, const InsertionSpec& spec, const std::string& key) {
+    const InsertionRequest& r = spec.request;
+    const double count = r.targetMass > 0.0 ? r.targetMass / spec.distribution->meanParticleMass(r.density)
+                                            : static_cast<double>(r.targetCount);
+    std::ostringstream what;
+    what << std::setprecision(3) << "about " << count << " particles";
+    // At once (no waves), every particle must fit in the region: not even spheres of the
+    // smallest size filling its whole volume reach this count.
+    const double dMin = spec.distribution->dMin();
+    const double capacity = spec.region->volumeBound() / (pi / 6.0 * dMin * dMin * dMin);
+    if (spec.waveInterval <= 0.0 && count > capacity) {
+        std::ostringstream m;
+        m << std::setprecision(3) << "expected a population the region can hold at once (no 'waveInterval'): asked for "
+          << what.str() << ", the region's volume holds fewer than " << capacity
+          << " even of the smallest (d = " << dMin << " m)";
+        invalid(d, key, m.str());
+    }
+    // Memory: every particle takes at least 400 bytes in the engine (docs/performance.md).
+    const double available = availableMemoryBytes();
+    if (available > 0.0 && count * 400.0 > available) {
+        std::ostringstream m;
+        m << std::setprecision(3) << "expected a population this machine can hold: asked for " << what.str() << ", at least "
+          << count * 400.0 / 1e9 << " GB, and " << available / 1e9 << " GB are available";
+        invalid(d, key, m.str());
+    }
+}
+
 std::vector<InsertionSpec> readInsertions(const Dictionary& root, const CaseSetup& setup) {
     std::vector<InsertionSpec> out;
     if (!root.has("insertion")) return out;
@@ -196,6 +240,7 @@ std::vector<InsertionSpec> readInsertions(const Dictionary& root, const CaseSetu
             spec.waveInterval = d.getPositive("waveInterval");
             r.placement.whenFull = WhenRegionFull::PlaceWhatFits;
         }
+        checkPopulationSize(d, spec, byMass ? "mass" : "count");
         out.push_back(std::move(spec));
     }
     return out;

@@ -324,7 +324,7 @@ std::string whatToChange(const PlacementOptions& options) {
     std::string advice = "enlarge the region";
     if (options.gapFraction > 0.0) advice += ", lower gapFraction";
     if (options.lattice == Lattice::SimpleCubic) advice += ", use the hexagonalClose lattice";
-    return advice + ", or insert in waves (WhenRegionFull::PlaceWhatFits)";
+    return advice + ", or insert in waves (keyword 'waveInterval')";
 }
 
 }  // namespace
@@ -378,6 +378,11 @@ Region Region::predicate(InsidePredicate inside, const Vec3& boundsMin, const Ve
     r.kind_ = Kind::Predicate;
     r.inside_ = std::move(inside);
     return r;
+}
+
+double Region::volumeBound() const {
+    if (kind_ == Kind::Cylinder) return M_PI * radius_ * radius_ * (axialMax_ - axialMin_);
+    return (boundsMax_ - boundsMin_).prod();
 }
 
 bool Region::containsSphere(const Vec3& centre, double radius) const {

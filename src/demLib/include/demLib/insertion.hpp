@@ -36,6 +36,9 @@ public:
     static Region predicate(InsidePredicate inside, const Vec3& boundsMin, const Vec3& boundsMax);
 
     bool containsSphere(const Vec3& centre, double radius) const;
+    // The region's volume (box, cylinder), or its bounding box's (predicate):
+    // never less than the volume particles can fill.
+    double volumeBound() const;
 
     Kind kind() const { return kind_; }
     const Vec3& boundsMin() const { return boundsMin_; }
