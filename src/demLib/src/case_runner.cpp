@@ -54,6 +54,7 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
         log_ << "Continuing from restart file " << restart << " at t = " << startTime_ << " s, step "
              << simulation_->stepCount() << ", " << simulation_->particles().size() << " particles\n";
     }
+    checkFieldOutputVolume(out);
     fields_ = std::make_unique<FieldOutput>(out.string(), "particles", restart.empty() ? -1.0 : startTime_);
 
     // The summary keeps the lines up to the restart time and continues after them.
@@ -150,6 +151,30 @@ std::string restartFileFor(const CaseSetup& setup, const std::string& arg, const
         if (fs::exists(inCase)) message += "; did you mean '" + inCase.string() + "'?";
     }
     throw InputError(message + "; expected a restart file or 'latest' (the newest one of the case)");
+}
+
+void CaseRunner::checkFieldOutputVolume(const fs::path& out) const {
+    // A fieldInterval below the time step writes a file every step (6 MB a step for
+    // 49 000 particles): a run that would fill the disk is refused before it writes,
+    // so that it cannot stop other runs' restart files from being written.
+    const OutputSpec& o = setup_.output;
+    double particles = 0.0;
+    for (const InsertionSpec& spec : setup_.insertions) particles += expectedParticleCount(spec);
+    particles = std::max(particles, static_cast<double>(simulation_->particles().size()));
+    const double interval = std::max(o.fieldInterval, simulation_->timeStep());
+    const double files = o.fieldInterval > 0.0 ? std::floor((setup_.endTime - startTime_) / interval) + 1.0 : 1.0;
+    const double bytes = files * particles * 120.0;  // measured 124 bytes per particle and file
+    std::error_code error;
+    const fs::space_info space = fs::space(out, error);
+    if (!error && bytes > static_cast<double>(space.available)) {
+        std::ostringstream m;
+        m << std::setprecision(3) << setup_.caseDir << "/constant/demProperties: keyword 'output/fieldInterval' = "
+          << o.fieldInterval << " s writes about " << files << " particle files of " << particles
+          << " particles until t = " << setup_.endTime << " s, at least " << bytes / 1e9 << " GB, and the disk of '"
+          << out.string() << "' has " << static_cast<double>(space.available) / 1e9
+          << " GB free; expected a fieldInterval whose output fits";
+        throw InputError(m.str());
+    }
 }
 
 void CaseRunner::performDueInsertions() {

@@ -163,9 +163,7 @@ std::shared_ptr<SizeDistribution> readDistribution(const Dictionary& d, double s
 // drawn: a mistyped mass (1e3 for 1e-3 kg) asks for hundreds of millions of
 // particles, gigabytes of diameters before the placement could refuse them.
 void checkPopulationSize(const Dictionary& d, const InsertionSpec& spec, const std::string& key) {
-    const InsertionRequest& r = spec.request;
-    const double count = r.targetMass > 0.0 ? r.targetMass / spec.distribution->meanParticleMass(r.density)
-                                            : static_cast<double>(r.targetCount);
+    const double count = expectedParticleCount(spec);
     std::ostringstream what;
     what << std::setprecision(3) << "about " << count << " particles";
     // At once (no waves), every particle must fit in the region: not even spheres of the
@@ -393,6 +391,13 @@ CaseSetup readCaseSetup(const Dictionary& root, const std::string& caseDir) {
 
 std::unique_ptr<Simulation> makeSimulation(const CaseSetup& setup) {
     return std::make_unique<Simulation>(setup.settings, setup.materials, setup.interactions, setup.walls);
+}
+
+double expectedParticleCount(const InsertionSpec& spec) {
+    if (!spec.explicitParticles.empty()) return static_cast<double>(spec.explicitParticles.size());
+    const InsertionRequest& r = spec.request;
+    return r.targetMass > 0.0 ? r.targetMass / spec.distribution->meanParticleMass(r.density)
+                              : static_cast<double>(r.targetCount);
 }
 
 std::vector<double> drawPopulation(const InsertionSpec& spec) {

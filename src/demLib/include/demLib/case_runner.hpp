@@ -4,6 +4,7 @@
 // interval in <output>/summary.csv, and progress with an ETA on the console.
 // Used by the demRun front end and, one fluid step at a time, by diefillFoam.
 #include <chrono>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <ostream>
@@ -64,6 +65,8 @@ private:
     void writeSummaryLine();
     void writeRestart();
     void readRunnerState(const std::string& restartFile);
+    // Throws InputError when the particle files asked for would not fit on the disk.
+    void checkFieldOutputVolume(const std::filesystem::path& outputDirectory) const;
     void progress(bool force);
 
     CaseSetup setup_;

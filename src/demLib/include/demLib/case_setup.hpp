@@ -82,6 +82,10 @@ std::unique_ptr<Simulation> makeSimulation(const CaseSetup& setup);
 // The diameters of an insertion block's whole population (deterministic from its seed).
 std::vector<double> drawPopulation(const InsertionSpec& spec);
 
+// The number of particles an insertion will place, expected before it is drawn:
+// the count, the listed particles, or the mass over the mean particle mass.
+double expectedParticleCount(const InsertionSpec& spec);
+
 // Places diameters[first...] in the block's region, avoiding the particles
 // already in `simulation` and its walls, and inserts them.  Returns how many
 // were placed: all of them, or (with a wave interval) those that fit now.
