@@ -55,6 +55,7 @@
 #include "demLib/case_setup.hpp"
 #include "demLib/command_line.hpp"
 #include "demLib/communicator.hpp"
+#include "demLib/constants.hpp"
 #include "demLib/error.hpp"
 #include "demLib/ghost_exchange.hpp"
 #include "demLib/simulation.hpp"
@@ -83,7 +84,6 @@ unsigned long long stateHash(const dem::ParticleStore& p) {
 }
 
 
-constexpr double pi = 3.14159265358979323846;
 
 using Clock = std::chrono::steady_clock;
 
@@ -152,7 +152,7 @@ std::vector<dem::InsertedParticle> randomSequentialAddition(const dem::Insertion
     std::vector<double> d = dem::drawDiametersForCount(dist, count, spec.request.placement.seed);
     std::sort(d.begin(), d.end(), std::greater<double>());
     double solid = 0.0;
-    for (double di : d) solid += pi / 6.0 * di * di * di;
+    for (double di : d) solid += dem::pi / 6.0 * di * di * di;
     const dem::Vec3 lo = spec.region->boundsMin();
     dem::Vec3 hi = spec.region->boundsMax();
     const double base = (hi.x() - lo.x()) * (hi.y() - lo.y());

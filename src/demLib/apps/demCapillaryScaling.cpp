@@ -16,12 +16,11 @@
 #include "demLib/capillary_force.hpp"
 #include "demLib/coarse_grain.hpp"
 #include "demLib/command_line.hpp"
+#include "demLib/constants.hpp"
 #include "demLib/error.hpp"
 #include "demLib/liquid_bridges.hpp"
 
 namespace {
-
-constexpr double pi = 3.14159265358979323846;
 
 struct Options {
     double radius = 1.0e-4;          // F32 sand, median diameter ≈ 0.2 mm (paper Table 1)
@@ -162,7 +161,7 @@ int main(int argc, char** argv) {
     const dem::CapillaryParameters capillary{options.surfaceTension, options.contactAngle};
     // Hertz between two equal spheres of the same material.
     const double effectiveModulus = options.youngsModulus / (2.0 * (1.0 - options.poissonRatio * options.poissonRatio));
-    const auto particleVolume = [](double radius) { return 4.0 / 3.0 * pi * radius * radius * radius; };
+    const auto particleVolume = [](double radius) { return 4.0 / 3.0 * dem::pi * radius * radius * radius; };
     // The water of one particle, w ρ_s V_p / ρ_w, shared over its z/2 bonds (paper §5 rule, monodisperse).
     const auto bridgeVolume = [&](double radius) {
         return options.waterContent * options.particleDensity * particleVolume(radius) / options.waterDensity /

@@ -7,6 +7,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "demLib/constants.hpp"
 #include "demLib/error.hpp"
 #include "demLib/triangle_mesh.hpp"
 
@@ -16,7 +17,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr double pi = 3.14159265358979323846;
 
 std::string resolve(const std::string& caseDir, const std::string& file) {
     const fs::path p(file);

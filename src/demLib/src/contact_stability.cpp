@@ -5,13 +5,13 @@
 #include <cmath>
 #include <limits>
 
+#include "demLib/constants.hpp"
 #include "demLib/contact_rolling_resistance.hpp"
 
 namespace dem {
 
 namespace {
 
-constexpr double pi = 3.14159265358979323846;
 
 Eigen::Matrix3d crossMatrix(const Eigen::Vector3d& v) {
     Eigen::Matrix3d m;

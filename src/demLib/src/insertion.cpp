@@ -17,6 +17,7 @@
 #include <utility>
 #include <sstream>
 
+#include "demLib/constants.hpp"
 #include "demLib/error.hpp"
 
 namespace dem {
@@ -381,7 +382,7 @@ Region Region::predicate(InsidePredicate inside, const Vec3& boundsMin, const Ve
 }
 
 double Region::volumeBound() const {
-    if (kind_ == Kind::Cylinder) return M_PI * radius_ * radius_ * (axialMax_ - axialMin_);
+    if (kind_ == Kind::Cylinder) return pi * radius_ * radius_ * (axialMax_ - axialMin_);
     return (boundsMax_ - boundsMin_).prod();
 }
 

@@ -3,13 +3,13 @@
 #include <cmath>
 #include <sstream>
 
+#include "demLib/constants.hpp"
 #include "demLib/contact_normal_hertz.hpp"  // kSqrtFiveSixths
 #include "demLib/error.hpp"
 
 namespace dem {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 std::string pairLabel(const Material& a, const Material& b) {
     return "materials '" + a.name + "' and '" + b.name + "'";
@@ -48,7 +48,7 @@ double effectiveShearModulus(const Material& a, const Material& b) {
 
 double dampingBetaFromRestitution(double restitution) {
     const double logE = std::log(restitution);
-    return logE / std::sqrt(logE * logE + kPi * kPi);
+    return logE / std::sqrt(logE * logE + pi * pi);
 }
 
 InteractionProperties makeInteraction(const Material& a, const Material& b,

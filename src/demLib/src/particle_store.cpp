@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include "demLib/constants.hpp"
+
 namespace dem {
 
 std::size_t ParticleStore::add(std::int64_t globalId, const Vec3& x, const Vec3& v, double r,
                                double density, int materialIndex) {
-    const double m = density * 4.0 / 3.0 * M_PI * r * r * r;
+    const double m = density * 4.0 / 3.0 * pi * r * r * r;
     id.push_back(globalId);
     position.push_back(x);
     velocity.push_back(v);

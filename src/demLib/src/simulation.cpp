@@ -5,6 +5,7 @@
 #include <limits>
 #include <sstream>
 
+#include "demLib/constants.hpp"
 #include "demLib/contact_stability.hpp"
 #include "demLib/error.hpp"
 #include "demLib/integrator.hpp"
@@ -148,7 +149,7 @@ Simulation::TimeStepLimits Simulation::timeStepLimits(const std::vector<Inserted
         limits.rayleigh = std::min(limits.rayleigh, settings_.maxRayleighFraction * criticalTimeStep(m, radius));
         // Two equal spheres head-on: LIGGGHTS uses the particle mass, R/2 and
         // the pair's Y*, at twice the characteristic speed.
-        const double mass = m.density * 4.0 / 3.0 * 3.14159265358979323846 * radius * radius * radius;
+        const double mass = m.density * 4.0 / 3.0 * pi * radius * radius * radius;
         const double hertz =
             hertzCollisionTime(mass, 0.5 * radius, effectiveYoungsModulus(m, m), 2.0 * settings_.impactVelocity);
         limits.hertz = std::min(limits.hertz, settings_.maxHertzFraction * hertz);

@@ -16,13 +16,13 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "demLib/constants.hpp"
 #include "demLib/error.hpp"
 
 namespace dem {
 
 namespace {
 
-constexpr double pi = 3.14159265358979323846;
 // Table 1 style inputs are rounded to whole percent; 0.5 accepts rounding but
 // rejects a forgotten row.
 constexpr double percentSumTolerance = 0.5;

@@ -22,13 +22,10 @@
 #include <string>
 #include <utility>
 
+#include "demLib/constants.hpp"
 #include "demLib/error.hpp"
 
 namespace dem {
-
-namespace capillary_detail {
-constexpr double pi = 3.14159265358979323846;
-}
 
 struct CapillaryParameters {
     double surfaceTension = 0.072;  // γ [N/m], water at 20 °C
@@ -82,7 +79,7 @@ inline CapillaryBridgeFit capillaryBridgeFit(double radius1, double radius2, dou
     fit.A = capillaryFitA(reducedVolume);
     fit.B = capillaryFitB(logVolume, parameters.contactAngle);
     fit.C = capillaryFitC(logVolume);
-    fit.prefactor = -capillary_detail::pi * parameters.surfaceTension * std::sqrt(radius1 * radius2);
+    fit.prefactor = -pi * parameters.surfaceTension * std::sqrt(radius1 * radius2);
     fit.contactForce = fit.prefactor * (std::exp(fit.B) + fit.C);
     return fit;
 }
@@ -132,7 +129,7 @@ inline void validateCapillaryParameters(const CapillaryParameters& parameters,
     if (!(parameters.surfaceTension >= 0.0) || !std::isfinite(parameters.surfaceTension))
         throw InputError(source + ": keyword 'surfaceTension' expects a finite number >= 0 [N/m], got " +
                          std::to_string(parameters.surfaceTension));
-    if (!(parameters.contactAngle >= 0.0 && parameters.contactAngle < 0.5 * capillary_detail::pi))
+    if (!(parameters.contactAngle >= 0.0 && parameters.contactAngle < 0.5 * pi))
         throw InputError(source + ": keyword 'contactAngle' expects radians in [0, pi/2), got " +
                          std::to_string(parameters.contactAngle));
 }

@@ -20,6 +20,7 @@
 //    and both vectors negated if the engine ever swaps i and j of a live contact.
 #include <cmath>
 
+#include "demLib/constants.hpp"
 #include "demLib/contact_normal_hertz.hpp"
 #include "demLib/contact_rolling_resistance.hpp"
 #include "demLib/contact_tangential_history.hpp"
@@ -132,7 +133,6 @@ struct ContactLaw {
 // exceeds a user-given fraction of it (typically 0.2).
 inline double rayleighTime(double radius, double density, double youngsModulus,
                            double poissonRatio) noexcept {
-    constexpr double pi = 3.14159265358979323846;
     const double shearModulus = youngsModulus / (2.0 * (1.0 + poissonRatio));
     return pi * radius * std::sqrt(density / shearModulus) / (0.1631 * poissonRatio + 0.8766);
 }
