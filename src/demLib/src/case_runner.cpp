@@ -30,10 +30,48 @@ long firstIndexAfter(double time, double interval) {
     return interval > 0.0 ? static_cast<long>(std::floor(time / interval + 1e-9)) + 1 : 0;
 }
 
+constexpr const char* caseTextMarker = "constant/demProperties as this run read it:";
+
+std::string readText(const fs::path& file) {
+    std::ifstream in(file);
+    std::ostringstream text;
+    text << in.rdbuf();
+    return text.str();
+}
+
+std::vector<std::string> linesOf(const std::string& text) {
+    std::vector<std::string> lines;
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);) {
+        while (!line.empty() && (line.back() == ' ' || line.back() == '\t' || line.back() == '\r')) line.pop_back();
+        lines.push_back(line);
+    }
+    return lines;
+}
+
+// The lines removed ("- ") and added ("+ ") from `before` to `after`, in file order
+// (a longest-common-subsequence diff; case files are a few hundred lines).
+std::vector<std::string> changedLines(const std::vector<std::string>& before, const std::vector<std::string>& after) {
+    const std::size_t n = before.size(), m = after.size();
+    std::vector<std::vector<int>> common(n + 1, std::vector<int>(m + 1, 0));
+    for (std::size_t i = n; i-- > 0;)
+        for (std::size_t j = m; j-- > 0;)
+            common[i][j] = before[i] == after[j] ? common[i + 1][j + 1] + 1 : std::max(common[i + 1][j], common[i][j + 1]);
+    std::vector<std::string> out;
+    std::size_t i = 0, j = 0;
+    while (i < n || j < m) {
+        if (i < n && j < m && before[i] == after[j]) { ++i; ++j; }
+        else if (j < m && (i == n || common[i][j + 1] >= common[i + 1][j])) out.push_back("+ " + after[j++]);
+        else out.push_back("- " + before[i++]);
+    }
+    return out;
+}
+
 }  // namespace
 
 CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream& log)
     : setup_(std::move(setup)), options_(options), log_(log) {
+    caseText_ = readText(fs::path(setup_.caseDir) / "constant" / "demProperties");
     simulation_ = makeSimulation(setup_);
     wetted_ = !(setup_.wettingTime > 0.0);
     const fs::path out = outputDirectory();
@@ -44,6 +82,8 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
     if (!restart.empty()) {
         simulation_->readRestart(restart);
         startTime_ = simulation_->time();
+        log_ << "Continuing from restart file " << restart << " at t = " << startTime_ << " s, step "
+             << simulation_->stepCount() << ", " << simulation_->particles().size() << " particles\n";
         readRunnerState(restart);
         // Wetting happens after the step that reaches wettingTime and before that
         // step's output, so a restart file at or after it holds the water.
@@ -51,8 +91,6 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
         // The file it was read from is this step's restart: finish() must not write it
         // again (a run continued at its end would rewrite the one file it has).
         lastRestartStep_ = simulation_->stepCount();
-        log_ << "Continuing from restart file " << restart << " at t = " << startTime_ << " s, step "
-             << simulation_->stepCount() << ", " << simulation_->particles().size() << " particles\n";
     }
     checkFieldOutputVolume(out);
     fields_ = std::make_unique<FieldOutput>(out.string(), "particles", restart.empty() ? -1.0 : startTime_);
@@ -117,6 +155,21 @@ void CaseRunner::readRunnerState(const std::string& restartFile) {
     if (insertionsDone_ > setup_.insertions.size())
         throw InputError("restart file '" + restartFile + "' records more insertion blocks than the case defines");
     if (placed_ > 0) population_ = drawPopulation(setup_.insertions[insertionsDone_]);
+    // Changing the case file between the pieces of a run is allowed (as in OpenFOAM);
+    // saying so keeps it from going unnoticed.
+    std::string line;
+    while (std::getline(in, line) && line != caseTextMarker) {
+    }
+    if (line != caseTextMarker) return;  // written before the case file was kept with it
+    std::ostringstream before;
+    before << in.rdbuf();
+    const std::vector<std::string> changes = changedLines(linesOf(before.str()), linesOf(caseText_));
+    if (changes.empty()) return;
+    log_ << "Note: constant/demProperties has changed since this restart file was written; the run goes on with "
+            "it as it is now (- then, + now):\n";
+    const std::size_t shown = std::min<std::size_t>(changes.size(), 12);
+    for (std::size_t k = 0; k < shown; ++k) log_ << "    " << changes[k] << "\n";
+    if (changes.size() > shown) log_ << "    (" << changes.size() - shown << " more changed lines)\n";
 }
 
 std::string CaseRunner::outputDirectory() const {
@@ -261,6 +314,8 @@ void CaseRunner::writeRestart() {
         // What the engine's restart file does not know: the insertion progress.
         std::ofstream state((dir / name.str()).string() + ".runner");
         state << std::setprecision(17) << insertionsDone_ << " " << placed_ << " " << nextWaveTime_ << "\n";
+        // and the case file it ran with, so that a continued run can say what changed since.
+        state << caseTextMarker << "\n" << caseText_;
     }
     const fs::path pointer = dir / "latest";
     {

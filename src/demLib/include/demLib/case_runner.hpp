@@ -70,6 +70,7 @@ private:
     void progress(bool force);
 
     CaseSetup setup_;
+    std::string caseText_;  // constant/demProperties as read at the start, kept with each restart file
     RunOptions options_;
     std::ostream& log_;
     std::unique_ptr<Simulation> simulation_;
