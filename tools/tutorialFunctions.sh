@@ -11,7 +11,7 @@
 #                               results of another variant or of other inputs, or when the generated
 #                               constant/demProperties was edited by hand (Allrun would overwrite it)
 #   tutorial_record             writes constant/runRecord (variant, checksums of demProperties.orig and of
-#                               the generated demProperties) just before the solver runs
+#                               the generated demProperties and system/controlDict) just before the solver runs
 #   tutorial_run_demRun         demRun (or $DEMRUN) in the case (log.demRun); continues from the newest
 #                               restart file when there is one (same variant and inputs: tutorial_guard);
 #                               wall time in TUTORIAL_DEM_SECONDS, and TUTORIAL_RUNTIME_ARGS = (-runTime S)
@@ -96,6 +96,13 @@ tutorial_guard() {
              "(Allrun's source, with the '// @quick' lines), or run ./Allclean to drop it." >&2
         exit 2
     fi
+    if [ -f system/controlDict.orig ] && [ -n "$(_tutorial_recorded controlDict)" ] \
+        && [ "$(_tutorial_md5 system/controlDict)" != "$(_tutorial_recorded controlDict)" ]; then
+        echo "$me: system/controlDict was changed after Allrun wrote it from system/controlDict.orig, and" \
+             "Allrun would overwrite the change; nothing done. Make the change in system/controlDict.orig," \
+             "or run ./Allclean to drop it." >&2
+        exit 2
+    fi
     tutorial_has_results || return 0
     recorded=$(_tutorial_recorded variant)
     if [ "$recorded" != "$VARIANT" ]; then
@@ -114,6 +121,7 @@ tutorial_guard() {
 tutorial_record() {
     printf 'variant %s\nsource %s\ngenerated %s\n' "$VARIANT" "$(_tutorial_md5 constant/demProperties.orig)" \
         "$(_tutorial_md5 constant/demProperties)" > constant/runRecord
+    [ ! -f system/controlDict.orig ] || printf 'controlDict %s\n' "$(_tutorial_md5 system/controlDict)" >> constant/runRecord
 }
 
 tutorial_prepare() {
