@@ -14,8 +14,8 @@
 #include <limits>
 #include <numeric>
 #include <random>
-#include <utility>
 #include <sstream>
+#include <utility>
 
 #include "demLib/constants.hpp"
 #include "demLib/error.hpp"
