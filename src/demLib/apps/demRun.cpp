@@ -3,6 +3,7 @@
 // Reads DIR/constant/demProperties, writes DIR/<output>/ (particle fields as
 // HDF5 + XDMF for ParaView, summary.csv, restart files) and DIR/log.demRun.
 #include <cmath>
+#include <csignal>
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
@@ -46,6 +47,16 @@ private:
     std::streambuf* b_;
 };
 
+// SIGINT (Ctrl-C) or SIGTERM (a batch system's time limit, kill): the run stops at the next
+// slice of steps and writes its restart file, so that no more than a slice is lost; a
+// second signal ends it at once (the default action is back).
+volatile std::sig_atomic_t stopSignal = 0;
+
+extern "C" void requestStop(int signal) {
+    stopSignal = signal;
+    std::signal(signal, SIG_DFL);
+}
+
 std::string utcNow() {
     const std::time_t now = std::time(nullptr);
     char text[32];
@@ -66,7 +77,8 @@ void usage(std::ostream& out) {
            "Writes into the case: log.demRun (a run with -restart adds to it), <output>/particles.xdmf\n"
            "(+ particles_*.h5; open the .xdmf in ParaView), <output>/summary.csv, <output>/restart/restart_*.h5.\n"
            "The input format is described in docs/case-reference.md.  Exit status: 0 on success, 1 on bad\n"
-           "input, 2 on a runtime failure.\n";
+           "input, 2 on a runtime failure, 128 + the signal when stopped by SIGINT or SIGTERM (the restart\n"
+           "file of that step is written first; a second signal ends it at once).\n";
 }
 
 }  // namespace
@@ -136,8 +148,21 @@ int main(int argc, char** argv) {
         dem::CaseSetup setup = dem::readCaseSetup(caseDir);
         if (endTime > 0.0) setup.endTime = endTime;
         dem::CaseRunner runner(std::move(setup), options, log);
-        runner.runToEnd();
+        std::signal(SIGINT, requestStop);
+        std::signal(SIGTERM, requestStop);
+        const dem::Simulation& simulation = runner.simulation();
+        const double end = runner.setup().endTime, dt = simulation.timeStep();
+        while (simulation.time() < end - 0.5 * dt && stopSignal == 0)
+            runner.advanceTo(simulation.time() + 200.0 * dt);  // slices: same results as one call
         runner.finish();
+        if (stopSignal != 0) {
+            const int signal = stopSignal;
+            log << "\ndemRun: stopped by " << (signal == SIGINT ? "SIGINT (Ctrl-C)" : "SIGTERM") << " at t = "
+                << simulation.time() << " s (step " << simulation.stepCount()
+                << "), its restart file written; continue with: demRun -case " << caseDir << " -restart latest"
+                << std::endl;
+            return 128 + signal;
+        }
         log << "End. Results in " << runner.outputDirectory() << " (open particles.xdmf in ParaView)" << std::endl;
         return 0;
     } catch (const dem::InputError& e) {
