@@ -37,6 +37,7 @@ Description
 
 #include "demCoupling.H"
 #include "progressReport.H"
+#include "stopSignal.H"
 
 // * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * //
 
@@ -83,6 +84,7 @@ int main(int argc, char *argv[])
 
     // A line with the ETA every 30 s of wall time (long die-filling runs)
     diefill::progressReport progress(runTime);
+    diefill::stopSignal stop;
 
     while (runTime.run())
     {
@@ -140,6 +142,15 @@ int main(int argc, char *argv[])
         runTime.printExecutionTime(Info);
 
         progress.update();
+
+        if (stop.requested())
+        {
+            Info<< "diefillFoam: stopped by " << stop.name() << " at t = "
+                << runTime.timeName() << " s: the air fields, particle forces and"
+                << " DEM restart file of this time are written; run again to"
+                << " continue from them" << nl << endl;
+            break;
+        }
     }
 
     // The end time is written even when it is not a multiple of writeInterval,
@@ -151,6 +162,14 @@ int main(int argc, char *argv[])
     }
 
     coupling.finish();
+
+    if (stop.requested())
+    {
+        // Everything is written.  Not 'return': argList's destructor ends the
+        // process with UPstream::exit(0), which would report a stopped run as
+        // finished.
+        UPstream::exit(128 + stop.signal());
+    }
 
     Info<< "End\n" << endl;
 
