@@ -101,13 +101,17 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
     if (!restart.empty() && fs::exists(summaryPath)) {
         std::ifstream in(summaryPath);
         std::string line;
+        bool lineAtRestart = false;
         while (std::getline(in, line)) {
             if (kept.empty()) { kept.push_back(line); continue; }
-            if (std::stod(line.substr(0, line.find(','))) <= startTime_ + 1e-12) kept.push_back(line);
+            const double t = std::stod(line.substr(0, line.find(',')));
+            if (t <= startTime_ + 1e-12) {
+                kept.push_back(line);
+                lineAtRestart = t >= startTime_ - 1e-12;
+            }
         }
         // A line at the restart time is this step's: finish() must not add it twice.
-        if (kept.size() > 1 && std::stod(kept.back().substr(0, kept.back().find(','))) >= startTime_ - 1e-12)
-            lastLogStep_ = simulation_->stepCount();
+        if (lineAtRestart) lastLogStep_ = simulation_->stepCount();
     }
     if (kept.empty()) {
         summary_.open(summaryPath, std::ios::trunc);

@@ -17,7 +17,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-
 std::string resolve(const std::string& caseDir, const std::string& file) {
     const fs::path p(file);
     return p.is_absolute() ? file : (fs::path(caseDir) / p).string();
