@@ -5,40 +5,28 @@
 #include "Pstream.H"
 #include "PstreamReduceOps.H"
 
-#include <csignal>
-
-namespace
-{
-    volatile std::sig_atomic_t received = 0;
-
-    extern "C" void requestStop(int signal)
-    {
-        received = signal;
-        std::signal(signal, SIG_DFL);
-    }
-}
+#include "demLib/stop_signal.hpp"
 
 
 Foam::diefill::stopSignal::stopSignal()
 {
-    std::signal(SIGINT, requestStop);
-    std::signal(SIGTERM, requestStop);
+    dem::catchStopSignals();
 }
 
 
 bool Foam::diefill::stopSignal::requested() const
 {
-    return returnReduce(received != 0, orOp<bool>());
+    return returnReduce(dem::stopSignalReceived() != 0, orOp<bool>());
 }
 
 
 int Foam::diefill::stopSignal::signal() const
 {
-    return returnReduce(label(received), maxOp<label>());
+    return returnReduce(label(dem::stopSignalReceived()), maxOp<label>());
 }
 
 
 Foam::word Foam::diefill::stopSignal::name() const
 {
-    return signal() == SIGINT ? word("SIGINT (Ctrl-C)") : word("SIGTERM");
+    return word(dem::stopSignalName(signal()));
 }

@@ -3,7 +3,6 @@
 // Reads DIR/constant/demProperties, writes DIR/<output>/ (particle fields as
 // HDF5 + XDMF for ParaView, summary.csv, restart files) and DIR/log.demRun.
 #include <cmath>
-#include <csignal>
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
@@ -20,6 +19,7 @@
 #include "demLib/case_runner.hpp"
 #include "demLib/command_line.hpp"
 #include "demLib/error.hpp"
+#include "demLib/stop_signal.hpp"
 #include "demLib/version.hpp"
 
 namespace {
@@ -46,16 +46,6 @@ private:
     std::streambuf* a_;
     std::streambuf* b_;
 };
-
-// SIGINT (Ctrl-C) or SIGTERM (a batch system's time limit, kill): the run stops at the next
-// slice of steps and writes its restart file, so that no more than a slice is lost; a
-// second signal ends it at once (the default action is back).
-volatile std::sig_atomic_t stopSignal = 0;
-
-extern "C" void requestStop(int signal) {
-    stopSignal = signal;
-    std::signal(signal, SIG_DFL);
-}
 
 std::string utcNow() {
     const std::time_t now = std::time(nullptr);
@@ -148,16 +138,16 @@ int main(int argc, char** argv) {
         dem::CaseSetup setup = dem::readCaseSetup(caseDir);
         if (endTime > 0.0) setup.endTime = endTime;
         dem::CaseRunner runner(std::move(setup), options, log);
-        std::signal(SIGINT, requestStop);
-        std::signal(SIGTERM, requestStop);
+        // Ctrl-C or SIGTERM: the run stops at the end of the current slice of steps and
+        // writes its restart file, so that no more than a slice is lost.
+        dem::catchStopSignals();
         const dem::Simulation& simulation = runner.simulation();
         const double end = runner.setup().endTime, dt = simulation.timeStep();
-        while (simulation.time() < end - 0.5 * dt && stopSignal == 0)
+        while (simulation.time() < end - 0.5 * dt && dem::stopSignalReceived() == 0)
             runner.advanceTo(simulation.time() + 200.0 * dt);  // slices: same results as one call
         runner.finish();
-        if (stopSignal != 0) {
-            const int signal = stopSignal;
-            log << "\ndemRun: stopped by " << (signal == SIGINT ? "SIGINT (Ctrl-C)" : "SIGTERM") << " at t = "
+        if (const int signal = dem::stopSignalReceived()) {
+            log << "\ndemRun: stopped by " << dem::stopSignalName(signal) << " at t = "
                 << simulation.time() << " s (step " << simulation.stepCount()
                 << "), its restart file written; continue with: demRun -case " << caseDir << " -restart latest"
                 << std::endl;
