@@ -14,7 +14,7 @@ import os
 import numpy as np
 
 from _common import argument_parser, frame_at, out_dir, run_main
-from diefillpost import plots, profile
+from diefillpost import output, plots, profile
 
 
 def main():
@@ -43,7 +43,7 @@ def main():
         fit = profile.fit_line(x, h, win)
         print(f"angle {fit['angle']:.2f} deg over [{win[0]*1e3:.1f}, {win[1]*1e3:.1f}] mm ({fit['points']} bins)")
     d = out_dir(a.case)
-    with open(os.path.join(d, a.name + ".csv"), "w", newline="") as fh:
+    with output.open_replacing(os.path.join(d, a.name + ".csv"), newline="") as fh:
         w = csv.writer(fh)
         w.writerow(["position_m", "height_m"])
         for xi, hi in zip(x, h):

@@ -33,7 +33,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _common import argument_parser, out_dir, run_main  # noqa: E402
-from diefillpost import foamdict, plots, profile, results, series, summary  # noqa: E402
+from diefillpost import foamdict, output, plots, profile, results, series, summary  # noqa: E402
 
 
 def profile_plot(path, x, h, fits, title):
@@ -52,9 +52,7 @@ def profile_plot(path, x, h, fits, title):
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     ax.set_title(title, fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    plots.save(fig, path, dpi=120)
 
 
 def first_time_reaching(t, values, level):
@@ -150,9 +148,7 @@ def air_plot(path, curves, summary_t, solid_volume_in_die, opening):
     axes[1].legend(fontsize=8)
     for ax in axes:
         ax.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    plots.save(fig, path, dpi=120)
 
 
 def shoe_pass_window(props):
@@ -347,7 +343,7 @@ def main():
     except ValueError as e:
         print("dieFilling.py: right border:", e)
 
-    with open(os.path.join(out, "profile.csv"), "w") as f:
+    with output.open_replacing(os.path.join(out, "profile.csv")) as f:
         f.write("x_mm,height_mm\n")
         for xi, hi in zip(x, h):
             f.write(f"{xi * 1e3:.4f},{'' if not np.isfinite(hi) else f'{hi * 1e3:.4f}'}\n")

@@ -18,7 +18,7 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from diefillpost import foamdict, geometry, plate, plots, results, series, summary  # noqa: E402
+from diefillpost import foamdict, geometry, output, plate, plots, results, series, summary  # noqa: E402
 from _common import argument_parser, run_main  # noqa: E402
 
 PAPER = {"start": 22.0, "at27": 0.35, "none_left": 37.0, "simulation50": 29.0}
@@ -71,7 +71,7 @@ def main():
 
     out = os.path.join(case, "postProcessing")
     os.makedirs(out, exist_ok=True)
-    with open(os.path.join(out, "slidFraction.csv"), "w", newline="") as fh:
+    with output.open_replacing(os.path.join(out, "slidFraction.csv"), newline="") as fh:
         w = csv.writer(fh)
         w.writerow(["time", "plateAngle_deg", "slidFraction", "movedFraction", "particles"])
         for r in rows:

@@ -18,6 +18,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (backend must be chosen first)
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _common import run_main  # noqa: E402
+from diefillpost.output import replacing  # noqa: E402
 
 
 def read_columns(path):
@@ -60,7 +61,8 @@ def main(argv):
     bond.legend(fontsize=8)
 
     figure.tight_layout()
-    figure.savefig(target, dpi=150)
+    with replacing(target) as tmp:
+        figure.savefig(tmp, dpi=150, format="png")
     print(f"plotCapillaryScaling: wrote {target}")
     return 0
 

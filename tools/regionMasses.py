@@ -15,7 +15,7 @@ import os
 import numpy as np
 
 from _common import argument_parser, out_dir, run_main
-from diefillpost import geometry, plots, series, summary
+from diefillpost import geometry, output, plots, series, summary
 
 
 def main():
@@ -44,17 +44,16 @@ def main():
     names = [k for k in columns if k != "time"]
     if not names:
         ap.error("no region: give -box/-cylinder, or define output/regions in demProperties")
+    ratios = [summary.fill_ratio(columns[k], a.reference) for k in names] if a.reference else []
     d = out_dir(a.case)
-    with open(os.path.join(d, a.name + ".csv"), "w", newline="") as fh:
+    with output.open_replacing(os.path.join(d, a.name + ".csv"), newline="") as fh:
         w = csv.writer(fh)
-        head = ["time"] + [f"mass_{k}" for k in names] + ([f"fillRatio_{k}" for k in names] if a.reference else [])
+        head = ["time"] + [f"mass_{k}" for k in names] + [f"fillRatio_{k}" for k in names if a.reference]
         w.writerow(head)
         for i, t in enumerate(columns["time"]):
-            row = [t] + [columns[k][i] for k in names]
-            if a.reference:
-                row += [summary.fill_ratio(columns[k][i], a.reference) for k in names]
+            row = [t] + [columns[k][i] for k in names] + [r[i] for r in ratios]
             w.writerow([f"{v:.6g}" for v in row])
-    ys = [summary.fill_ratio(columns[k], a.reference) for k in names] if a.reference else [columns[k] * 1e3 for k in names]
+    ys = ratios if a.reference else [columns[k] * 1e3 for k in names]
     plots.curve(os.path.join(d, a.name + ".png"), columns["time"], ys, names, "time [s]",
                 "fill ratio [-]" if a.reference else "mass [g]")
     print(f"wrote {os.path.join(d, a.name)}.csv/.png")

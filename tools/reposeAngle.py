@@ -20,7 +20,7 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from diefillpost import foamdict, geometry, plots, profile, results, series, summary  # noqa: E402
+from diefillpost import foamdict, geometry, output, plots, profile, results, series, summary  # noqa: E402
 from _common import argument_parser, run_main  # noqa: E402
 
 PAPER_ANGLE = 28.0
@@ -57,7 +57,7 @@ def main():
 
     out = os.path.join(case, "postProcessing")
     os.makedirs(out, exist_ok=True)
-    with open(os.path.join(out, "profile.csv"), "w", newline="") as fh:
+    with output.open_replacing(os.path.join(out, "profile.csv"), newline="") as fh:
         w = csv.writer(fh)
         w.writerow(["radius_m", "height_m", "sectorsWithParticles"])
         for ri, hi, ni in zip(r, h, n):

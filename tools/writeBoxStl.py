@@ -12,6 +12,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _common import argument_parser, run_main  # noqa: E402
+from diefillpost.output import open_replacing  # noqa: E402
 
 
 def box_triangles(lo, hi):
@@ -26,7 +27,7 @@ def box_triangles(lo, hi):
 
 
 def write_stl(path, triangles, name="box"):
-    with open(path, "w") as f:
+    with open_replacing(path) as f:
         f.write(f"solid {name}\n")
         for a, b, c in triangles:
             n = np.cross(b - a, c - a)

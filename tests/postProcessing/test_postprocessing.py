@@ -361,6 +361,25 @@ def help_option_of_every_tool():
                   f"(exit {r.returncode}, stderr {r.stderr.strip()[-200:]!r})")
 
 
+@test
+def replacing_output_only_when_complete():
+    from diefillpost import output
+    path = os.path.join(TMP, "replace.csv")
+    with open(path, "w") as f:
+        f.write("old\n")
+    try:
+        with output.open_replacing(path) as f:
+            f.write("half")
+            raise RuntimeError("stopped")
+    except RuntimeError:
+        pass
+    check("open_replacing: an error in the block keeps the old file", open(path).read() == "old\n"
+          and os.listdir(TMP).count("replace.csv") == 1 and not [n for n in os.listdir(TMP) if n.startswith(".replace")])
+    with output.open_replacing(path) as f:
+        f.write("new\n")
+    check("open_replacing: the new content once complete", open(path).read() == "new\n")
+
+
 import shutil  # noqa: E402
 
 shutil.rmtree(TMP, ignore_errors=True)

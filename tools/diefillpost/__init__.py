@@ -9,5 +9,6 @@ Modules (one concept each):
     plate      mass on a tilting plate, slid fraction vs plate angle
     plots      PNG pictures (matplotlib, Agg)
     results    results.json + results.csv
+    output     output files that replace the old ones only once complete
 """
-__all__ = ["foamdict", "series", "summary", "geometry", "profile", "plate", "plots", "results"]
+__all__ = ["foamdict", "series", "summary", "geometry", "profile", "plate", "plots", "results", "output"]

@@ -1,4 +1,6 @@
 """PNG pictures (matplotlib with the Agg backend; no display needed)."""
+import os
+
 import matplotlib
 
 matplotlib.use("Agg")
@@ -7,12 +9,18 @@ import numpy as np  # noqa: E402
 from matplotlib.collections import EllipseCollection  # noqa: E402
 
 from .geometry import unit  # noqa: E402
+from .output import replacing  # noqa: E402
 
 
-def _save(fig, path):
+def save(fig, path, dpi=130):
+    """Writes the figure to `path` (its format from the extension), replacing an
+    earlier picture only once the new one is complete, and closes it."""
     fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    try:
+        with replacing(path) as tmp:
+            fig.savefig(tmp, dpi=dpi, format=os.path.splitext(path)[1][1:] or "png")
+    finally:
+        plt.close(fig)
     return path
 
 
@@ -29,7 +37,7 @@ def profile_with_fit(path, x, h, fit=None, title="", xlabel="distance [mm]"):
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     ax.set_title(title, fontsize=9)
-    return _save(fig, path)
+    return save(fig, path)
 
 
 def curve(path, x, ys, labels, xlabel, ylabel, title="", hlines=(), vlines=(), points=()):
@@ -48,7 +56,7 @@ def curve(path, x, ys, labels, xlabel, ylabel, title="", hlines=(), vlines=(), p
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     ax.set_title(title, fontsize=9)
-    return _save(fig, path)
+    return save(fig, path)
 
 
 def side_view(path, frame, horizontal=(1, 0, 0), up=(0, 0, 1), color_by="height", title="", vmax=None):
@@ -81,4 +89,4 @@ def side_view(path, frame, horizontal=(1, 0, 0), up=(0, 0, 1), color_by="height"
     ax.set_ylabel("height [mm]")
     fig.colorbar(coll, ax=ax, label=label, shrink=0.8)
     ax.set_title(title or f"t = {frame.time:.3f} s, {frame.count} particles", fontsize=9)
-    return _save(fig, path)
+    return save(fig, path)

@@ -3,6 +3,8 @@ import csv
 import json
 import os
 
+from .output import open_replacing
+
 
 def write(case_dir, results, name="results"):
     """results: {key: {"value": v, "unit": u, "description": d}} or {key: v}.
@@ -11,10 +13,10 @@ def write(case_dir, results, name="results"):
     os.makedirs(out, exist_ok=True)
     rows = {k: (v if isinstance(v, dict) and "value" in v else {"value": v}) for k, v in results.items()}
     jpath, cpath = os.path.join(out, name + ".json"), os.path.join(out, name + ".csv")
-    with open(jpath, "w") as f:
+    with open_replacing(jpath) as f:
         json.dump(rows, f, indent=2)
         f.write("\n")
-    with open(cpath, "w", newline="") as f:
+    with open_replacing(cpath, newline="") as f:
         w = csv.writer(f)
         w.writerow(["quantity", "value", "unit", "description"])
         for k, r in rows.items():
