@@ -8,11 +8,16 @@ from diefillpost import series  # noqa: E402
 
 
 def frame_at(case, time=None):
-    """The output nearest to `time` (the last one when None)."""
-    entries = series.list_frames(case)
+    """The output nearest to `time` (the last one when None: then only that file is
+    read, so a damaged older one does not matter).  A frame without particles is a
+    ValueError naming its file."""
     if time is None:
-        return series.read_frame(entries[-1][1])
-    return series.read_frame(min(entries, key=lambda e: abs(e[0] - time))[1])
+        frame = series.read_frame(series.last_path(case))
+    else:
+        frame = series.read_frame(min(series.list_frames(case), key=lambda e: abs(e[0] - time))[1])
+    if frame.count == 0:
+        raise ValueError(f"'{frame.path}' (t = {frame.time:g} s) holds no particles: nothing to measure or draw")
+    return frame
 
 
 def argument_parser(doc):

@@ -21,12 +21,36 @@ from _common import run_main  # noqa: E402
 from diefillpost.output import replacing  # noqa: E402
 
 
+COLUMNS = ("l", "ratioContact", "ratioGap", "ratioFixedVolumeContact", "ratioFixedVolumeFixedGap", "paperFit",
+           "bondRatioUncorrected", "bondRatioEq9", "bondRatioKappa2")
+
+
 def read_columns(path):
+    """The columns of the CSV as lists of numbers; a missing column, a line with
+    another number of fields than the header or a field that is not a number is a
+    ValueError naming the file (and the line)."""
     with open(path, newline="") as handle:
-        rows = list(csv.DictReader(handle))
-    if not rows:
-        sys.exit(f"plotCapillaryScaling: '{path}' has no data rows")
-    return {key: [float(row[key]) for row in rows] for key in rows[0]}
+        lines = list(csv.reader(handle))
+    if not lines:
+        raise ValueError(f"'{path}' is empty (no header); expected the CSV written by demCapillaryScaling")
+    header = lines[0]
+    missing = [name for name in COLUMNS if name not in header]
+    if missing:
+        raise ValueError(f"'{path}': no column {', '.join(missing)}; expected the CSV written by demCapillaryScaling")
+    columns = {key: [] for key in header}
+    for number, row in enumerate(lines[1:], start=2):
+        if not row:
+            continue
+        if len(row) != len(header):
+            raise ValueError(f"'{path}' line {number}: {len(row)} fields, the header has {len(header)}")
+        for key, text in zip(header, row):
+            try:
+                columns[key].append(float(text))
+            except ValueError:
+                raise ValueError(f"'{path}' line {number}: '{text}' is not a number") from None
+    if not columns["l"]:
+        raise ValueError(f"'{path}' has no data rows")
+    return columns
 
 
 def main(argv):

@@ -380,6 +380,127 @@ def replacing_output_only_when_complete():
     check("open_replacing: the new content once complete", open(path).read() == "new\n")
 
 
+def run_tool(script, *args):
+    return subprocess.run([sys.executable, os.path.join(ROOT, "tools", script)] + [str(a) for a in args],
+                          capture_output=True, text=True)
+
+
+def one_line_error(r, script, *words):
+    """A refused run: exit status not 0, one line '<script>: error: ...' holding all
+    `words`, no traceback."""
+    lines = r.stderr.strip().splitlines()
+    return (r.returncode != 0 and len(lines) == 1 and lines[0].startswith(f"{script}: error: ")
+            and all(w in lines[0] for w in words) and "Traceback" not in r.stderr)
+
+
+def small_case(name):
+    """A case of 3 particles at t = 0 and t = 1 (the cli case of command_line_tools)."""
+    case = os.path.join(TMP, name)
+    pos = np.array([[0.001, 0, 0.001], [0.002, 0, 0.003], [0.05, 0, 0.001]])
+    write_case(case, "a 1;\n", [(0.0, pos, [5e-4] * 3), (1.0, pos + [0, 0, 0.1], [5e-4] * 3)],
+               [(0, 0, 3, 0, 0, 0, 0, 0), (1, 1, 3, 0, 0, 0, 0, 0)])
+    return case
+
+
+def broken_summaries():
+    """(what, summary.csv text, words the message must hold)."""
+    head = "time,step,particles,kineticEnergy,coordinationNumber,wallContacts,lostCount,lostMass"
+    return [("empty", "", ["summary.csv", "empty"]),
+            ("a short row", head + "\n0,0,3,0,0,0,0,0\n0.5,1,3,0,0,0,0\n", ["summary.csv", "line 3", "7 fields", "the header has 8"]),
+            ("a header longer than the rows", head + ",mass_die\n0,0,3,0,0,0,0,0\n",
+             ["summary.csv", "line 2", "8 fields", "the header has 9"]),
+            ("no time column", head.replace("time,", "t,") + "\n0,0,3,0,0,0,0,0\n", ["summary.csv", "no column 'time'"]),
+            ("a field that is not a number", head + "\n0,0,3,x,0,0,0,0\n", ["summary.csv", "line 2", "'x'"]),
+            ("no data line", head + "\n", ["summary.csv", "no data"])]
+
+
+@test
+def malformed_summary_is_named():
+    # An empty summary.csv gave 'error: time', a short row 'setting an array element
+    # with a sequence', a longer header 'cannot reshape array': neither the file nor
+    # what was wrong.
+    for what, text, words in broken_summaries():
+        case = small_case("summary_" + what.replace(" ", "_"))
+        with open(os.path.join(case, "dem", "summary.csv"), "w") as f:
+            f.write(text)
+        try:
+            summary.read(case)
+            check(f"summary.read, {what}: ValueError", False, "(accepted)")
+        except ValueError as e:
+            check(f"summary.read, {what}: ValueError naming the file and the fault",
+                  all(w in str(e) for w in words) and case in str(e), str(e))
+        except Exception as e:
+            check(f"summary.read, {what}: ValueError", False, f"({type(e).__name__}: {e})")
+        r = run_tool("regionMasses.py", "-case", case)
+        check(f"regionMasses.py, summary.csv with {what}: one line naming the file",
+              one_line_error(r, "regionMasses.py", *words), f"(exit {r.returncode}, {r.stderr.strip()[-300:]!r})")
+    case = small_case("summary_columns")
+    try:
+        summary.read(case)["mass_die"]
+        check("summary.read: a missing column is a KeyError naming the file", False)
+    except KeyError as e:
+        check("summary.read: a missing column is a KeyError naming the file and the column",
+              "summary.csv" in e.args[0] and "mass_die" in e.args[0], e.args[0])
+
+
+@test
+def damaged_particle_file_is_named():
+    # A truncated particles_*.h5: the tools said 'Unable to open file (truncated
+    # file...)' without naming it; sideView.py without -time failed on an older
+    # truncated frame (the series was read whole) though it draws the newest only.
+    case = small_case("truncated")
+    old = os.path.join(case, "dem", "particles_000000000.h5")
+    with open(old, "r+b") as f:
+        f.truncate(1000)
+    for script, args in (("regionMasses.py", ["-box", "b", -1, -1, -1, 1, 1, 1]),
+                         ("bedProfile.py", ["-time", 0, "-line", 0, 0, 0, 1, 0, 0]),
+                         ("sideView.py", ["-time", 0])):
+        r = run_tool(script, "-case", case, *args)
+        check(f"{script} on a truncated frame: one line naming it", one_line_error(r, script, "particles_000000000.h5"),
+              f"(exit {r.returncode}, {r.stderr.strip()[-300:]!r})")
+    for index in ("particles.series", None):
+        if index is None:
+            os.remove(os.path.join(case, "dem", "particles.series"))
+        r = run_tool("sideView.py", "-case", case, "-name", "newest")
+        check(f"sideView.py without -time ({index or 'no index'}): draws the newest frame, the damaged older one unread",
+              r.returncode == 0 and os.path.exists(os.path.join(case, "postProcessing", "newest.png")), r.stderr.strip()[-300:])
+        r = run_tool("bedProfile.py", "-case", case, "-line", 0, 0, 0, 1, 0, 0)
+        check(f"bedProfile.py without -time ({index or 'no index'}): the newest frame", r.returncode == 0, r.stderr.strip()[-300:])
+    try:
+        series.read_frame(old)
+        check("read_frame on a truncated file: ValueError", False)
+    except ValueError as e:
+        check("read_frame on a truncated file: ValueError naming it", old in str(e), str(e))
+    empty = os.path.join(TMP, "not_particles.h5")
+    with h5py.File(empty, "w") as h:
+        h["x"] = np.zeros(3)
+    try:
+        series.read_frame(empty)
+        check("read_frame on a file without particle fields: ValueError", False)
+    except ValueError as e:
+        check("read_frame on a file without particle fields: ValueError naming it and the field",
+              empty in str(e) and "position" in str(e), str(e))
+
+
+@test
+def capillary_scaling_csv_is_checked():
+    head = ("l,radius_m,bridgeVolume_m3,weight_N,hertzOverlap_m,capillaryContact_N,capillaryGap_N,ratioContact,ratioGap,"
+            "ratioFixedVolumeContact,ratioFixedVolumeFixedGap,paperFit,contactToCapillary,bondUncorrected,bondEq9,"
+            "bondKappa2,bondRatioUncorrected,bondRatioEq9,bondRatioKappa2")
+    good = os.path.join(TMP, "scaling.csv")
+    with open(good, "w") as f:
+        f.write(head + "\n" + "\n".join(",".join(str(l * (k + 1)) for k in range(19)) for l in (1, 2, 4)) + "\n")
+    r = run_tool("plotCapillaryScaling.py", good)
+    check("plotCapillaryScaling.py: a PNG from a good CSV", r.returncode == 0 and os.path.exists(good[:-4] + ".png"),
+          r.stderr.strip()[-300:])
+    short = os.path.join(TMP, "scaling_short.csv")
+    with open(short, "w") as f:
+        f.write(head + "\n1,2,3\n")
+    r = run_tool("plotCapillaryScaling.py", short)
+    check("plotCapillaryScaling.py, a short row: one line naming the file and the line",
+          one_line_error(r, "plotCapillaryScaling.py", "scaling_short.csv", "line 2"), r.stderr.strip()[-300:])
+
+
 import shutil  # noqa: E402
 
 shutil.rmtree(TMP, ignore_errors=True)

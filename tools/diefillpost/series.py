@@ -47,10 +47,24 @@ class Frame:
 
 
 def read_frame(path):
-    with h5py.File(path, "r") as f:
-        arrays = {k: f[k][()] for k in FIELDS if k in f}
-        time = f.attrs["time"]
-        step = f.attrs["step"] if "step" in f.attrs else 0
+    """The frame in one particle file; a file that HDF5 cannot read (truncated by a
+    run that stopped while writing it, say) or that lacks the positions or the time
+    is a ValueError naming it."""
+    try:
+        with h5py.File(path, "r") as f:
+            missing = [k for k in ("position", "radius", "mass") if k not in f]
+            if "time" not in f.attrs:
+                missing.append("attribute 'time'")
+            if missing:
+                raise ValueError(f"'{path}' is not a particle field file: no {', '.join(missing)}")
+            arrays = {k: f[k][()] for k in FIELDS if k in f}
+            time = f.attrs["time"]
+            step = f.attrs["step"] if "step" in f.attrs else 0
+    except FileNotFoundError:
+        raise
+    except (OSError, KeyError, RuntimeError) as e:
+        raise ValueError(f"'{path}' cannot be read ({e}): a truncated or damaged particle file; "
+                         "remove it (and its line in particles.series) or write it again") from None
     for k in ("position", "velocity", "omega", "force"):
         if k in arrays:
             arrays[k] = np.asarray(arrays[k], float).reshape(-1, 3)
@@ -61,29 +75,62 @@ def output_dir(case_dir, directory="dem"):
     return os.path.join(case_dir, directory)
 
 
-def list_frames(case_dir, directory="dem"):
-    """[(time, path)] in time order, from particles.series (or the xdmf index, or a glob)."""
+def _by_step(out):
+    """The particles_<step>.h5 files in `out` in step order (the name holds the step)."""
+    paths = glob.glob(os.path.join(out, "particles_*.h5"))
+    step = re.compile(r"particles_(\d+)\.h5$")
+    return sorted(paths, key=lambda p: (int(step.search(p).group(1)) if step.search(p) else -1, p))
+
+
+def _indexed(case_dir, directory):
+    """[(time, path)] from particles.series (or the xdmf index); None without an index."""
     out = output_dir(case_dir, directory)
     index = os.path.join(out, "particles.series")
     entries = []
     if os.path.exists(index):
         with open(index) as f:
-            for line in f:
+            for number, line in enumerate(f, start=1):
                 parts = line.split()
                 if len(parts) == 4:
-                    entries.append((float(parts[0]), os.path.join(out, parts[3])))
+                    try:
+                        entries.append((float(parts[0]), os.path.join(out, parts[3])))
+                    except ValueError:
+                        raise ValueError(f"'{index}' line {number}: '{parts[0]}' is not a time; expected "
+                                         "lines 'time step particles file'") from None
     elif os.path.exists(os.path.join(out, "particles.xdmf")):
         text = open(os.path.join(out, "particles.xdmf")).read()
         for t, name in re.findall(r'<Time Value="([^"]+)"/>.*?>([^<>:]+\.h5):/position<', text, flags=re.S):
             entries.append((float(t), os.path.join(out, name)))
     else:
-        for p in sorted(glob.glob(os.path.join(out, "particles_*.h5"))):
-            entries.append((read_frame(p).time, p))
-    entries = [e for e in entries if os.path.exists(e[1])]
+        return None
+    return [e for e in entries if os.path.exists(e[1])]
+
+
+def _no_frames(case_dir, directory):
+    out = output_dir(case_dir, directory)
+    return FileNotFoundError(f"no particle fields (particles_*.h5) in '{out}'; run demRun first")
+
+
+def list_frames(case_dir, directory="dem"):
+    """[(time, path)] in time order, from particles.series (or the xdmf index, or the
+    times in the files themselves when there is no index)."""
+    entries = _indexed(case_dir, directory)
+    if entries is None:
+        entries = [(read_frame(p).time, p) for p in _by_step(output_dir(case_dir, directory))]
     entries.sort()
     if not entries:
-        raise FileNotFoundError(f"no particle fields (particles_*.h5) in '{out}'; run demRun first")
+        raise _no_frames(case_dir, directory)
     return entries
+
+
+def last_path(case_dir, directory="dem"):
+    """The newest particle file, found without opening the others (from the index, or
+    by the step in the file names)."""
+    entries = _indexed(case_dir, directory)
+    paths = _by_step(output_dir(case_dir, directory)) if entries is None else [p for _, p in sorted(entries)]
+    if not paths:
+        raise _no_frames(case_dir, directory)
+    return paths[-1]
 
 
 def frames(case_dir, directory="dem"):
@@ -92,4 +139,4 @@ def frames(case_dir, directory="dem"):
 
 
 def last_frame(case_dir, directory="dem"):
-    return read_frame(list_frames(case_dir, directory)[-1][1])
+    return read_frame(last_path(case_dir, directory))
