@@ -1,7 +1,10 @@
 """Shared helpers of the command-line scripts in tools/."""
 import argparse
+import math
 import os
 import sys
+
+import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from diefillpost import series  # noqa: E402
@@ -20,13 +23,79 @@ def frame_at(case, time=None):
     return frame
 
 
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):
+        """One line naming the option and what was wrong (argparse would print the
+        whole usage first); exit status 2 as argparse."""
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} -help)\n")
+
+
 def argument_parser(doc):
     """An argparse parser whose help is -help, as in OpenFOAM's and demLib's tools
-    (and -h, --help); argparse alone takes '-help' for '-h elp' and fails."""
-    parser = argparse.ArgumentParser(description=doc, add_help=False,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    (and -h, --help); argparse alone takes '-help' for '-h elp' and fails.  A bad
+    option is one line: '<tool>: error: argument -X: ...'."""
+    parser = _Parser(description=doc, add_help=False, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("-help", "-h", "--help", action="help", help="show this help and exit")
     return parser
+
+
+def _number(text, kind=float):
+    try:
+        value = kind(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a {'whole ' if kind is int else ''}number, got '{text}'") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"expected a finite number, got '{text}'")
+    return value
+
+
+def finite(text):
+    """argparse type: a finite number (not nan or inf)."""
+    return _number(text)
+
+
+def positive(text):
+    """argparse type: a finite number above zero."""
+    value = _number(text)
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"expected a number above zero, got '{text}'")
+    return value
+
+
+def non_negative(text):
+    """argparse type: a finite number, zero or above."""
+    value = _number(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected a number of zero or more, got '{text}'")
+    return value
+
+
+def positive_int(text):
+    """argparse type: a whole number of at least 1."""
+    value = _number(text, int)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a whole number of at least 1, got '{text}'")
+    return value
+
+
+def direction(parser, option, vector, across=None, across_option=None):
+    """`vector` (given with `option`) as a unit vector; a zero vector, or one along
+    `across` (given with `across_option`) when that is given, is a parser error."""
+    v = np.asarray(vector, float)
+    n = float(np.linalg.norm(v))
+    if not n > 0:
+        parser.error(f"argument {option}: the direction ({' '.join(f'{x:g}' for x in v)}) is zero")
+    v = v / n
+    if across is not None and np.linalg.norm(np.cross(v, np.asarray(across, float) / np.linalg.norm(across))) < 1e-6:
+        parser.error(f"argument {option}: the direction ({' '.join(f'{x:g}' for x in vector)}) is along "
+                     f"{across_option}; expected one across it")
+    return v
+
+
+def ordered(parser, option, low, high, what="values"):
+    """A parser error unless low < high (the two `what` of `option`)."""
+    if not low < high:
+        parser.error(f"argument {option}: expected the first of the two {what} below the second, got {low:g} {high:g}")
 
 
 def out_dir(case):

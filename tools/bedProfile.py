@@ -10,36 +10,49 @@ fitted and its angle reported; -window auto takes the pile flank (80 %-20 % of t
 Writes postProcessing/<N>.csv and <N>.png (N default 'bedProfile')."""
 import csv
 import os
+from argparse import ArgumentTypeError
 
 import numpy as np
 
-from _common import argument_parser, frame_at, out_dir, run_main
+from _common import argument_parser, direction, finite, frame_at, ordered, out_dir, positive, positive_int, run_main
 from diefillpost import output, plots, profile
 
 
 def main():
     ap = argument_parser(__doc__)
     ap.add_argument("-case", default=".")
-    ap.add_argument("-time", type=float, default=None)
+    ap.add_argument("-time", type=finite, default=None)
     g = ap.add_mutually_exclusive_group(required=True)
-    g.add_argument("-line", type=float, nargs=6, metavar="V")
-    g.add_argument("-axis", type=float, nargs=6, metavar="V")
-    ap.add_argument("-up", type=float, nargs=3, default=(0, 0, 1))
-    ap.add_argument("-band", type=float, default=None, help="half-width of the band around the line [m]")
-    ap.add_argument("-sectors", type=int, default=8)
-    ap.add_argument("-binWidth", type=float, default=None, help="[m] (default 1.5 mean diameters)")
+    g.add_argument("-line", type=finite, nargs=6, metavar="V")
+    g.add_argument("-axis", type=finite, nargs=6, metavar="V")
+    ap.add_argument("-up", type=finite, nargs=3, default=(0, 0, 1))
+    ap.add_argument("-band", type=positive, default=None, help="half-width of the band around the line [m]")
+    ap.add_argument("-sectors", type=positive_int, default=8)
+    ap.add_argument("-binWidth", type=positive, default=None, help="[m] (default 1.5 mean diameters)")
     ap.add_argument("-window", nargs=2, default=None, help="fit window in mm, or 'auto auto'")
     ap.add_argument("-name", default="bedProfile")
     a = ap.parse_args()
+    if a.line:
+        along = direction(ap, "-line", a.line[3:])
+        direction(ap, "-up", a.up, along, "-line")
+    else:
+        direction(ap, "-axis", a.axis[3:])
+    window = None
+    if a.window and a.window != ["auto", "auto"]:
+        try:
+            window = [finite(v) * 1e-3 for v in a.window]
+        except ArgumentTypeError:
+            ap.error(f"argument -window: expected two numbers (mm) or 'auto auto', got '{' '.join(a.window)}'")
+        ordered(ap, "-window", *window, what="positions")
     f = frame_at(a.case, a.time)
-    bw = a.binWidth or 1.5 * float(np.mean(2 * f.radius))
+    bw = a.binWidth if a.binWidth is not None else 1.5 * float(np.mean(2 * f.radius))
     if a.line:
         x, h = profile.line_profile(f.position, f.radius, a.line[:3], a.line[3:], a.up, bw, band=a.band)
     else:
         x, h, _ = profile.radial_profile(f.position, f.radius, a.axis[:3], a.axis[3:], bw, sectors=a.sectors)
     fit = None
     if a.window:
-        win = profile.flank_window(x, h) if a.window[0] == "auto" else (float(a.window[0]) * 1e-3, float(a.window[1]) * 1e-3)
+        win = window or profile.flank_window(x, h)
         fit = profile.fit_line(x, h, win)
         print(f"angle {fit['angle']:.2f} deg over [{win[0]*1e3:.1f}, {win[1]*1e3:.1f}] mm ({fit['points']} bins)")
     d = out_dir(a.case)

@@ -32,7 +32,7 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _common import argument_parser, out_dir, run_main  # noqa: E402
+from _common import argument_parser, finite, non_negative, out_dir, run_main  # noqa: E402
 from diefillpost import foamdict, output, plots, profile, results, series, summary  # noqa: E402
 
 
@@ -282,8 +282,8 @@ def report_before_opening(case, out, props, s, frames, poured, fill, opening, en
 def main():
     ap = argument_parser(__doc__)
     ap.add_argument("-case", default=".")
-    ap.add_argument("-openingStart", type=float, default=None)
-    ap.add_argument("-runTime", type=float, default=None, help="wall time of the run [s], for the summary")
+    ap.add_argument("-openingStart", type=finite, default=None)
+    ap.add_argument("-runTime", type=non_negative, default=None, help="wall time of the run [s], for the summary")
     a = ap.parse_args()
     case = a.case
     props = foamdict.read_case(case)          # constant/demProperties

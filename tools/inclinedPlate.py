@@ -19,7 +19,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from diefillpost import foamdict, geometry, output, plate, plots, results, series, summary  # noqa: E402
-from _common import argument_parser, run_main  # noqa: E402
+from _common import argument_parser, non_negative, positive, run_main  # noqa: E402
 
 PAPER = {"start": 22.0, "at27": 0.35, "none_left": 37.0, "simulation50": 29.0}
 
@@ -28,9 +28,9 @@ def main():
     ap = argument_parser(__doc__)
     ap.add_argument("-case", default=".")
     ap.add_argument("-plate", default="plate", help="name of the plate wall (type stl) in demProperties")
-    ap.add_argument("-height", type=float, default=0.02, help="on-plate height limit above the top face [m]")
-    ap.add_argument("-moved", type=float, default=2e-3, help="down-slope displacement counted as moved [m]")
-    ap.add_argument("-runTime", type=float, default=None, help="demRun wall time [s] to record")
+    ap.add_argument("-height", type=positive, default=0.02, help="on-plate height limit above the top face [m]")
+    ap.add_argument("-moved", type=non_negative, default=2e-3, help="down-slope displacement counted as moved [m]")
+    ap.add_argument("-runTime", type=non_negative, default=None, help="demRun wall time [s] to record")
     a = ap.parse_args()
     case = a.case
     props = foamdict.read_case(case)
@@ -47,6 +47,9 @@ def main():
     ref = series.read_frame((before or entries)[-1][1])
     t_ref = ref.time
     m0 = float(np.sum(ref.mass[plate.on_plate(ref, pose, t_ref, lo, hi, a.height)]))
+    if not m0 > 0:
+        raise ValueError(f"'{ref.path}' (t = {t_ref:g} s, the tilting starts at {t_tilt:g} s): no particle on the "
+                         f"plate '{a.plate}' (within -height {a.height:g} m of its top face)")
     # down-slope direction in the plate frame: gravity seen from the plate at the end
     g = np.asarray(props["simulation"]["gravity"], float)
     R_end, _ = pose.pose(rot[-1]["end"])

@@ -11,11 +11,45 @@ mass/M is written too (e.g. M = the mass that fills the die).  Writes
 postProcessing/<N>.csv and <N>.png (N default 'regionMasses')."""
 import csv
 import os
+from argparse import ArgumentTypeError
 
 import numpy as np
 
-from _common import argument_parser, out_dir, run_main
+from _common import argument_parser, direction, finite, ordered, out_dir, positive, run_main
 from diefillpost import geometry, output, plots, series, summary
+
+
+def numbers(parser, option, name, values):
+    """The numbers after a region's name, each checked as finite; a parser error names
+    the option and the region."""
+    try:
+        return [finite(v) for v in values]
+    except ArgumentTypeError as e:
+        parser.error(f"argument {option} {name}: {e}")
+
+
+def regions_from_options(parser, boxes, cylinders):
+    """{name: region} from the -box and -cylinder options, checked: min below max,
+    a non-zero axis, a radius above zero, a range low < high, names given once."""
+    regions = {}
+    for option, name, region in [("-box", b[0], b[1:]) for b in boxes] + [("-cylinder", c[0], c[1:]) for c in cylinders]:
+        if name in regions or name == "time":
+            parser.error(f"argument {option} {name}: the name " + ("is taken by the time column" if name == "time"
+                                                                  else "is given to two regions"))
+        v = numbers(parser, option, name, region)
+        if option == "-box":
+            for axis, lo, hi in zip("xyz", v[0:3], v[3:6]):
+                if not lo < hi:
+                    parser.error(f"argument -box {name}: min {axis} ({lo:g}) is not below max {axis} ({hi:g}); "
+                                 "expected X0 Y0 Z0 (min) then X1 Y1 Z1 (max)")
+            regions[name] = geometry.Box(v[0:3], v[3:6])
+        else:
+            direction(parser, f"-cylinder {name}", v[3:6])
+            if not v[6] > 0:
+                parser.error(f"argument -cylinder {name}: the radius ({v[6]:g}) is not above zero")
+            ordered(parser, f"-cylinder {name}", v[7], v[8], what="axial limits Z0 Z1")
+            regions[name] = geometry.Cylinder(v[0:3], v[3:6], v[6], v[7], v[8])
+    return regions
 
 
 def main():
@@ -23,13 +57,10 @@ def main():
     ap.add_argument("-case", default=".")
     ap.add_argument("-box", nargs=7, action="append", default=[], metavar="V")
     ap.add_argument("-cylinder", nargs=10, action="append", default=[], metavar="V")
-    ap.add_argument("-reference", type=float, default=None)
+    ap.add_argument("-reference", type=positive, default=None, help="[kg] the mass of a full region")
     ap.add_argument("-name", default="regionMasses")
     a = ap.parse_args()
-    regions = {b[0]: geometry.Box([float(v) for v in b[1:4]], [float(v) for v in b[4:7]]) for b in a.box}
-    for c in a.cylinder:
-        v = [float(x) for x in c[1:]]
-        regions[c[0]] = geometry.Cylinder(v[0:3], v[3:6], v[6], v[7], v[8])
+    regions = regions_from_options(ap, a.box, a.cylinder)
     columns = {}
     if regions:
         times, masses = [], {k: [] for k in regions}

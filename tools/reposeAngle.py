@@ -21,7 +21,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from diefillpost import foamdict, geometry, output, plots, profile, results, series, summary  # noqa: E402
-from _common import argument_parser, run_main  # noqa: E402
+from _common import argument_parser, finite, non_negative, ordered, positive, positive_int, run_main  # noqa: E402
 
 PAPER_ANGLE = 28.0
 
@@ -30,12 +30,17 @@ def main():
     ap = argument_parser(__doc__)
     ap.add_argument("-case", default=".")
     ap.add_argument("-tube", default="tube", help="name of the lifted cylinder wall (gives the axis)")
-    ap.add_argument("-binWidth", type=float, default=None, help="radial bin [m] (default: 1.5 mean diameters)")
-    ap.add_argument("-sectors", type=int, default=8)
-    ap.add_argument("-heights", type=float, nargs=2, default=(0.2, 0.8), metavar=("LOW", "HIGH"))
-    ap.add_argument("-window", type=float, nargs=2, default=None, metavar=("RA", "RB"), help="fit window [mm]")
-    ap.add_argument("-runTime", type=float, default=None, help="demRun wall time [s] to record")
+    ap.add_argument("-binWidth", type=positive, default=None, help="radial bin [m] (default: 1.5 mean diameters)")
+    ap.add_argument("-sectors", type=positive_int, default=8)
+    ap.add_argument("-heights", type=finite, nargs=2, default=(0.2, 0.8), metavar=("LOW", "HIGH"))
+    ap.add_argument("-window", type=finite, nargs=2, default=None, metavar=("RA", "RB"), help="fit window [mm]")
+    ap.add_argument("-runTime", type=non_negative, default=None, help="demRun wall time [s] to record")
     a = ap.parse_args()
+    if not 0 <= a.heights[0] < a.heights[1] <= 1:
+        ap.error(f"argument -heights: expected fractions of the peak height 0 <= LOW < HIGH <= 1, "
+                 f"got {a.heights[0]:g} {a.heights[1]:g}")
+    if a.window:
+        ordered(ap, "-window", *a.window, what="radii")
     case = a.case
     props = foamdict.read_case(case)
     tube = props["walls"][a.tube]
@@ -43,7 +48,7 @@ def main():
     f = series.last_frame(case)
     if f.count == 0:
         sys.exit("reposeAngle.py: the last output holds no particles")
-    bw = a.binWidth or 1.5 * float(np.mean(2 * f.radius))
+    bw = a.binWidth if a.binWidth is not None else 1.5 * float(np.mean(2 * f.radius))
     r, h, n = profile.radial_profile(f.position, f.radius, axis_point, axis, bw, sectors=a.sectors)
     window = tuple(np.asarray(a.window) * 1e-3) if a.window else profile.flank_window(r, h, *a.heights)
     fit = profile.fit_line(r, h, window)

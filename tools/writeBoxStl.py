@@ -11,7 +11,7 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _common import argument_parser, run_main  # noqa: E402
+from _common import argument_parser, finite, run_main  # noqa: E402
 from diefillpost.output import open_replacing  # noqa: E402
 
 
@@ -42,7 +42,7 @@ def write_stl(path, triangles, name="box"):
 def main():
     p = argument_parser(__doc__)
     p.add_argument("out")
-    p.add_argument("coords", type=float, nargs=6, metavar="X")
+    p.add_argument("coords", type=finite, nargs=6, metavar="X")
     p.add_argument("-name", default="box")
     a = p.parse_args()
     lo, hi = a.coords[:3], a.coords[3:]

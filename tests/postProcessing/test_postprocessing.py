@@ -361,25 +361,6 @@ def help_option_of_every_tool():
                   f"(exit {r.returncode}, stderr {r.stderr.strip()[-200:]!r})")
 
 
-@test
-def replacing_output_only_when_complete():
-    from diefillpost import output
-    path = os.path.join(TMP, "replace.csv")
-    with open(path, "w") as f:
-        f.write("old\n")
-    try:
-        with output.open_replacing(path) as f:
-            f.write("half")
-            raise RuntimeError("stopped")
-    except RuntimeError:
-        pass
-    check("open_replacing: an error in the block keeps the old file", open(path).read() == "old\n"
-          and os.listdir(TMP).count("replace.csv") == 1 and not [n for n in os.listdir(TMP) if n.startswith(".replace")])
-    with output.open_replacing(path) as f:
-        f.write("new\n")
-    check("open_replacing: the new content once complete", open(path).read() == "new\n")
-
-
 def run_tool(script, *args):
     return subprocess.run([sys.executable, os.path.join(ROOT, "tools", script)] + [str(a) for a in args],
                           capture_output=True, text=True)
@@ -400,6 +381,133 @@ def small_case(name):
     write_case(case, "a 1;\n", [(0.0, pos, [5e-4] * 3), (1.0, pos + [0, 0, 0.1], [5e-4] * 3)],
                [(0, 0, 3, 0, 0, 0, 0, 0), (1, 1, 3, 0, 0, 0, 0, 0)])
     return case
+
+
+def outputs(case):
+    """{name: content} of the files in case/postProcessing."""
+    d = os.path.join(case, "postProcessing")
+    return {n: open(os.path.join(d, n), "rb").read() for n in os.listdir(d)} if os.path.isdir(d) else {}
+
+
+@test
+def bad_option_values_are_refused():
+    # Zero, negative, NaN or contradictory values of the numeric options: one line
+    # naming the option, a non-zero exit, and no output written.  Before, -sectors 0
+    # ended in an IndexError traceback, -binWidth -1 wrote a garbage bedProfile.csv
+    # with exit 0, a -box with min > max gave mass 0 at every time with exit 0.
+    case = small_case("options")
+    line = ["-line", 0, 0, 0, 1, 0, 0]
+    axis = ["-axis", 0, 0, 0, 0, 0, 1]
+    cases = [
+        ("bedProfile.py", axis + ["-sectors", 0], "-sectors"),
+        ("bedProfile.py", axis + ["-sectors", -3], "-sectors"),
+        ("bedProfile.py", line + ["-binWidth", -1], "-binWidth"),
+        ("bedProfile.py", line + ["-binWidth", 0], "-binWidth"),
+        ("bedProfile.py", line + ["-binWidth", "nan"], "-binWidth"),
+        ("bedProfile.py", line + ["-band", 0], "-band"),
+        ("bedProfile.py", line + ["-time", "nan"], "-time"),
+        ("bedProfile.py", line + ["-window", 5, 2], "-window"),
+        ("bedProfile.py", line + ["-window", "auto", "x"], "-window"),
+        ("bedProfile.py", line + ["-up", 1, 0, 0], "-up"),
+        ("bedProfile.py", ["-axis", 0, 0, 0, 0, 0, 0], "-axis"),
+        ("bedProfile.py", ["-line", 0, 0, 0, 0, 0, "nan"], "-line"),
+        ("regionMasses.py", ["-box", "b", 1, 1, 1, 0, 0, 0], "-box b"),
+        ("regionMasses.py", ["-box", "b", 0, 0, 0, 1, "nan", 1], "-box b"),
+        ("regionMasses.py", ["-box", "b", 0, 0, 0, 1, "one", 1], "-box b"),
+        ("regionMasses.py", ["-cylinder", "c", 0, 0, 0, 0, 0, 1, -1, 0, 1], "-cylinder c"),
+        ("regionMasses.py", ["-cylinder", "c", 0, 0, 0, 0, 0, 0, 1, 0, 1], "-cylinder c"),
+        ("regionMasses.py", ["-cylinder", "c", 0, 0, 0, 0, 0, 1, 1, 1, 0], "-cylinder c"),
+        ("regionMasses.py", ["-box", "b", 0, 0, 0, 1, 1, 1, "-reference", -3], "-reference"),
+        ("regionMasses.py", ["-box", "b", 0, 0, 0, 1, 1, 1, "-reference", 0], "-reference"),
+        ("sideView.py", ["-time", "nan"], "-time"),
+        ("sideView.py", ["-horizontal", 0, 0, 2], "-horizontal"),
+        ("sideView.py", ["-up", 0, 0, 0], "-up"),
+        ("reposeAngle.py", ["-sectors", 0], "-sectors"),
+        ("reposeAngle.py", ["-binWidth", -1], "-binWidth"),
+        ("reposeAngle.py", ["-heights", 0.8, 0.2], "-heights"),
+        ("reposeAngle.py", ["-window", 5, 2], "-window"),
+        ("reposeAngle.py", ["-runTime", -1], "-runTime"),
+        ("inclinedPlate.py", ["-height", 0], "-height"),
+        ("inclinedPlate.py", ["-moved", -1], "-moved"),
+        ("dieFilling.py", ["-openingStart", "nan"], "-openingStart"),
+        ("dieFilling.py", ["-runTime", -1], "-runTime"),
+    ]
+    # the repose and plate cases of the end-to-end tests, on which the scripts run
+    case_of = {"reposeAngle.py": os.path.join(TMP, "repose"), "inclinedPlate.py": os.path.join(TMP, "plate")}
+    before = {c: outputs(c) for c in set(case_of.values()) | {case}}
+    for script, args, option in cases:
+        r = run_tool(script, "-case", case_of.get(script, case), *args)
+        check(f"{script} {' '.join(str(a) for a in args)}: refused naming {option}", one_line_error(r, script, option),
+              f"(exit {r.returncode}, stderr {r.stderr.strip()[-300:]!r})")
+    r = run_tool("writeBoxStl.py", os.path.join(TMP, "box.stl"), 0, 0, 0, 1, 1, "inf")
+    check("writeBoxStl.py with an infinite corner: refused", one_line_error(r, "writeBoxStl.py", "inf"),
+          r.stderr.strip()[-300:])
+    for c, files in before.items():
+        check(f"refused options leave {os.path.basename(c)}/postProcessing as it was", outputs(c) == files,
+              str(sorted(outputs(c))))
+
+
+@test
+def library_refuses_meaningless_parameters():
+    p = np.array([[0.001, 0, 0.001], [0.002, 0, 0.003]])
+    for what, call in (("radial_profile sectors 0", lambda: profile.radial_profile(p, 5e-4, sectors=0)),
+                       ("radial_profile bin_width -1", lambda: profile.radial_profile(p, 5e-4, bin_width=-1)),
+                       ("line_profile bin_width nan", lambda: profile.line_profile(p, 5e-4, bin_width=np.nan)),
+                       ("sector_angles sectors 0", lambda: profile.sector_angles(p, 5e-4, (0, 0, 0), (0, 0, 1), 1e-3, (0, 1), 0)),
+                       ("Box min > max", lambda: geometry.Box((1, 0, 0), (0, 1, 1))),
+                       ("Cylinder radius 0", lambda: geometry.Cylinder((0, 0, 0), (0, 0, 1), 0, 0, 1)),
+                       ("fill_ratio reference nan", lambda: summary.fill_ratio([1], np.nan))):
+        try:
+            call()
+            check(f"{what}: ValueError", False, "(accepted)")
+        except ValueError:
+            check(f"{what}: ValueError", True)
+        except Exception as e:
+            check(f"{what}: ValueError", False, f"({type(e).__name__}: {e})")
+
+
+@test
+def refused_reference_keeps_the_old_results():
+    # regionMasses.py -reference -3 named an internal function ('fill_ratio:
+    # reference_mass must be positive') and had already truncated the good
+    # regionMasses.csv of an earlier run to its header.
+    case = small_case("keep")
+    box = ["-box", "b", -1, -1, -1, 1, 1, 1]
+    r = run_tool("regionMasses.py", "-case", case, *box)
+    csv_path = os.path.join(case, "postProcessing", "regionMasses.csv")
+    good = open(csv_path).read() if r.returncode == 0 else ""
+    check("regionMasses.py: a first good run", r.returncode == 0 and len(good.splitlines()) == 3, r.stderr.strip()[-300:])
+    r = run_tool("regionMasses.py", "-case", case, *box, "-reference", -3)
+    check("regionMasses.py -reference -3: one line naming -reference, not fill_ratio",
+          one_line_error(r, "regionMasses.py", "-reference", "-3") and "fill_ratio" not in r.stderr, r.stderr.strip()[-300:])
+    check("regionMasses.py -reference -3: the earlier regionMasses.csv is intact", open(csv_path).read() == good)
+    # a failure half-way through a write (here: a frame that cannot be read) keeps it too
+    with open(os.path.join(case, "dem", "particles_000000001.h5"), "r+b") as f:
+        f.truncate(1000)
+    r = run_tool("regionMasses.py", "-case", case, *box, "-reference", 1)
+    check("regionMasses.py on a damaged frame: the earlier regionMasses.csv is intact",
+          r.returncode != 0 and open(csv_path).read() == good, r.stderr.strip()[-300:])
+    check("no temporary file is left behind", sorted(os.listdir(os.path.join(case, "postProcessing")))
+          == ["regionMasses.csv", "regionMasses.png"], str(os.listdir(os.path.join(case, "postProcessing"))))
+
+
+@test
+def replacing_output_only_when_complete():
+    from diefillpost import output
+    path = os.path.join(TMP, "replace.csv")
+    with open(path, "w") as f:
+        f.write("old\n")
+    try:
+        with output.open_replacing(path) as f:
+            f.write("half")
+            raise RuntimeError("stopped")
+    except RuntimeError:
+        pass
+    check("open_replacing: an error in the block keeps the old file", open(path).read() == "old\n"
+          and os.listdir(TMP).count("replace.csv") == 1 and not [n for n in os.listdir(TMP) if n.startswith(".replace")])
+    with output.open_replacing(path) as f:
+        f.write("new\n")
+    check("open_replacing: the new content once complete", open(path).read() == "new\n")
 
 
 def broken_summaries():

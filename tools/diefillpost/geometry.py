@@ -70,6 +70,9 @@ def wall_pose(case_dict, wall_name):
 class Box:
     def __init__(self, lo, hi):
         self.lo, self.hi = np.asarray(lo, float), np.asarray(hi, float)
+        if self.lo.shape != (3,) or self.hi.shape != (3,) or not np.all(self.lo < self.hi):
+            raise ValueError(f"box: expected min below max in x, y and z, got min {self.lo.tolist()} "
+                             f"max {self.hi.tolist()}")
 
     def contains(self, x):
         x = np.asarray(x, float)
@@ -80,6 +83,9 @@ class Cylinder:
     def __init__(self, axis_point, axis, radius, lo, hi):
         self.a, self.e = np.asarray(axis_point, float), unit(axis)
         self.radius, self.lo, self.hi = float(radius), float(lo), float(hi)
+        if not (np.isfinite(self.radius) and self.radius > 0 and self.lo < self.hi and np.all(np.isfinite(self.a))):
+            raise ValueError(f"cylinder: expected a radius above zero and a range low < high, got radius "
+                             f"{self.radius:g}, range {self.lo:g} {self.hi:g}")
 
     def contains(self, x):
         d = np.asarray(x, float) - self.a

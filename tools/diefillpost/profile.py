@@ -4,6 +4,18 @@ import numpy as np
 from .geometry import unit
 
 
+def _positive(name, value):
+    """A ValueError unless `value` is a finite number above zero."""
+    if not (np.isfinite(value) and value > 0):
+        raise ValueError(f"{name} must be a finite number above zero, got {value}")
+
+
+def _sectors(sectors):
+    if int(sectors) != sectors or sectors < 1:
+        raise ValueError(f"sectors must be a whole number of at least 1, got {sectors}")
+    return int(sectors)
+
+
 def _binned_max(coord, top, edges, groups=None, n_groups=1):
     """Max of `top` per (group, bin); NaN where a bin is empty."""
     nb = len(edges) - 1
@@ -33,6 +45,8 @@ def radial_profile(position, radius, axis_point=(0, 0, 0), axis=(0, 0, 1), bin_w
     highest particle top (axial coordinate + radius); the profile is the mean over
     the sectors that hold particles in that bin.  Heights are measured from `base`
     along `axis`.  Returns (bin centres, height, number of sectors with data)."""
+    _positive("bin_width", bin_width)
+    sectors = _sectors(sectors)
     x = np.asarray(position, float) - np.asarray(axis_point, float)
     e = unit(axis)
     z = x @ e
@@ -53,6 +67,8 @@ def sector_angles(position, radius, axis_point, axis, bin_width, window, sectors
     profile of that sector's particles alone (radial_profile with one sector) fitted
     over `window` (fit_line); sectors with fewer than 3 points in the window are left
     out.  Returns the list of angles (deg), whose spread shows how round the pile is."""
+    _positive("bin_width", bin_width)
+    sectors = _sectors(sectors)
     position, radius = np.asarray(position, float), np.asarray(radius, float)
     x = position - np.asarray(axis_point, float)
     e = unit(axis)
@@ -74,13 +90,18 @@ def line_profile(position, radius, origin=(0, 0, 0), direction=(1, 0, 0), up=(0,
     `up` + radius) per bin of the coordinate along `direction`, for particles within
     `band` of the vertical plane through the line (all particles when None).
     Returns (bin centres, height) with NaN in empty bins."""
+    _positive("bin_width", bin_width)
     x = np.asarray(position, float) - np.asarray(origin, float)
     d, n = unit(direction), unit(up)
     s, h = x @ d, x @ n + np.asarray(radius, float)
     keep = np.ones(len(x), bool)
     if band is not None:
+        _positive("band", band)
         across = np.cross(n, d)
         keep = np.abs(x @ across) <= band
+    if extent is None and not keep.any():
+        raise ValueError(f"no particle within the band of {band:g} m around the line" if band is not None
+                         else "no particles")
     lo, hi = (np.min(s[keep]), np.max(s[keep]) + 1e-12) if extent is None else extent
     edges = np.arange(lo, hi + 0.5 * bin_width, bin_width)
     return 0.5 * (edges[1:] + edges[:-1]), _binned_max(s[keep], h[keep], edges)[0]
@@ -127,6 +148,7 @@ def edge_angle(position, radius, origin=(0, 0, 0), direction=(1, 0, 0), up=(0, 0
     the height of the bed's top near the edge (particles in its outer half), and the
     angle above the horizontal is atan(1/|b|): 90 deg for a vertical edge.
     Returns dict(angle, slope_ds_dh, window (heights), points)."""
+    _positive("bin_height", bin_height)
     x = np.asarray(position, float) - np.asarray(origin, float)
     d, n = unit(direction), unit(up)
     r = np.asarray(radius, float) * np.ones(len(x))
