@@ -104,6 +104,12 @@ Options parseOptions(int argc, char** argv, bool& helpRequested) {
     positive("-youngsModulus", options.youngsModulus);
     positive("-gravity", options.gravity);
     positive("-waterContent", options.waterContent);
+    // As in constant/demProperties (cohesion/waterContent); a radius of a metre or more is
+    // no grain (1e300 gave inf and nan in the table).
+    if (!(options.waterContent <= 1.0))
+        throw dem::InputError("command line: option '-waterContent' expects a number in (0, 1] (water mass / dry mass)");
+    if (!(options.radius < 1.0))
+        throw dem::InputError("command line: option '-radius' expects a particle radius below 1 m");
     if (!(options.poissonRatio > -1.0 && options.poissonRatio < 0.5))
         throw dem::InputError("command line: option '-poissonRatio' expects a number in (-1, 0.5)");
     if (!(options.gapFraction >= 0.0 && options.gapFraction < 1.0))

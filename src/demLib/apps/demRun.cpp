@@ -28,6 +28,7 @@ namespace {
 class TeeBuffer : public std::streambuf {
 public:
     TeeBuffer(std::streambuf* a, std::streambuf* b) : a_(a), b_(b) {}
+    void setSecond(std::streambuf* b) { b_ = b; }
 
 protected:
     int overflow(int c) override {
@@ -121,14 +122,22 @@ int main(int argc, char** argv) {
 #endif
     // A continued run adds to the log of the run it continues (whose earlier part the
     // restart file's results belong to); a new run starts a new log, as its results do.
+    // The log is opened once the run has started: until then its lines are held here,
+    // so that a run refused for its input leaves the log of the earlier run as it was.
     std::ofstream logFile;
     const bool continuing = !options.restartFrom.empty();
-    if (std::filesystem::is_directory(caseDir))
-        logFile.open(std::filesystem::path(caseDir) / "log.demRun", continuing ? std::ios::app : std::ios::trunc);
-    if (continuing && logFile.is_open())
-        logFile << "\n==== demRun -restart " << options.restartFrom << ": continued at " << utcNow() << "\n";
-    TeeBuffer tee(std::cout.rdbuf(), logFile.is_open() ? logFile.rdbuf() : nullptr);
+    std::stringbuf beforeStart;
+    TeeBuffer tee(std::cout.rdbuf(), &beforeStart);
     std::ostream log(&tee);
+    const auto openLog = [&] {
+        if (!std::filesystem::is_directory(caseDir)) return;
+        logFile.open(std::filesystem::path(caseDir) / "log.demRun", continuing ? std::ios::app : std::ios::trunc);
+        if (!logFile.is_open()) return;
+        if (continuing)
+            logFile << "\n==== demRun -restart " << options.restartFrom << ": continued at " << utcNow() << "\n";
+        logFile << beforeStart.str() << std::flush;
+        tee.setSecond(logFile.rdbuf());
+    };
     try {
         log << "demRun (demLib " << dem::versionString << "), case " << std::filesystem::absolute(caseDir).string()
 #ifdef _OPENMP
@@ -138,6 +147,8 @@ int main(int argc, char** argv) {
         dem::CaseSetup setup = dem::readCaseSetup(caseDir);
         if (endTime > 0.0) setup.endTime = endTime;
         dem::CaseRunner runner(std::move(setup), options, log);
+        log.flush();
+        openLog();
         // Ctrl-C or SIGTERM: the run stops at the end of the current slice of steps and
         // writes its restart file, so that no more than a slice is lost.
         dem::catchStopSignals();
@@ -155,11 +166,11 @@ int main(int argc, char** argv) {
         }
         log << "End. Results in " << runner.outputDirectory() << " (open particles.xdmf in ParaView)" << std::endl;
         return 0;
-    } catch (const dem::InputError& e) {
-        log << "\ndemRun: input error: " << e.what() << std::endl;
-        return 1;
     } catch (const std::exception& e) {
-        log << "\ndemRun: error: " << e.what() << std::endl;
-        return 2;
+        const bool inputError = dynamic_cast<const dem::InputError*>(&e) != nullptr;
+        log << "\ndemRun: " << (inputError ? "input error: " : "error: ") << e.what() << std::endl;
+        if (!logFile.is_open())
+            log << "demRun: the run did not start; log.demRun and the case's results are as they were" << std::endl;
+        return inputError ? 1 : 2;
     }
 }

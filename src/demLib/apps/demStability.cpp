@@ -129,6 +129,9 @@ int main(int argc, char** argv) {
                       << "), elapsed " << std::lround(elapsed) << " s, about "
                       << std::lround(elapsed / trial * std::max(0, expected - trial)) << " s left" << std::endl;
         };
+        if (sim->particles().empty())
+            throw dem::InputError("demStability: the restart file '" + restart +
+                                  "' holds no particle; expected a bed to analyse");
         const dem::BedStabilityReport r = dem::analyseBedStability(*sim, options);
         if (r.particles == 0 && !sim->particles().empty())
             throw dem::InputError("demStability: -region holds no particle centre of the bed (expected a box "

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <vector>
 
+#include "demLib/command_line.hpp"
 #include "demLib/error.hpp"
 
 namespace dem {
@@ -91,6 +92,21 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
         // The file it was read from is this step's restart: finish() must not write it
         // again (a run continued at its end would rewrite the one file it has).
         lastRestartStep_ = simulation_->stepCount();
+        if (setup_.endTime < startTime_ - 0.5 * simulation_->timeStep())
+            throw InputError("end time " + std::to_string(setup_.endTime) + " s (keyword 'endTime' or -endTime) is " +
+                             "before the restart time " + std::to_string(startTime_) +
+                             " s; expected an end time after it");
+    }
+    for (const InsertionSpec& spec : setup_.insertions)
+        if (spec.time > setup_.endTime)
+            log_ << "Note: " << spec.context << " starts at t = " << spec.time << " s, after the end time "
+                 << setup_.endTime << " s: this run inserts none of it\n";
+    // A new run places its first particles before it opens any output: an error in
+    // them (a particle in a wall, a step too large for the stiffness) must leave the
+    // results of an earlier run in the case as they are.
+    if (restart.empty()) {
+        performDueInsertions();
+        performDueWetting();
     }
     checkFieldOutputVolume(out);
     fields_ = std::make_unique<FieldOutput>(out.string(), "particles", restart.empty() ? -1.0 : startTime_);
@@ -102,9 +118,14 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
         std::ifstream in(summaryPath);
         std::string line;
         bool lineAtRestart = false;
-        while (std::getline(in, line)) {
+        for (std::size_t lineNumber = 1; std::getline(in, line); ++lineNumber) {
             if (kept.empty()) { kept.push_back(line); continue; }
-            const double t = std::stod(line.substr(0, line.find(',')));
+            if (line.find_first_not_of(" \t\r") == std::string::npos) continue;  // a blank line holds nothing
+            double t = 0.0;
+            if (!parseNumber(line.substr(0, line.find(',')), t))
+                throw InputError("'" + summaryPath.string() + "' line " + std::to_string(lineNumber) + ": '" +
+                                 line.substr(0, 40) + "' does not start with a time; expected the lines demRun " +
+                                 "wrote (time,step,...): mend or remove the line to continue the run");
             if (t <= startTime_ + 1e-12) {
                 kept.push_back(line);
                 lineAtRestart = t >= startTime_ - 1e-12;
@@ -139,11 +160,7 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
     nextLog_ = firstIndexAfter(startTime_, setup_.output.logInterval);
     nextRestart_ = firstIndexAfter(startTime_, setup_.output.restartInterval);
 
-    if (restart.empty()) {
-        performDueInsertions();
-        performDueWetting();
-        writeDueOutput(true);
-    }
+    if (restart.empty()) writeDueOutput(true);
     wallStart_ = lastProgress_ = std::chrono::steady_clock::now();
     stepsAtStart_ = simulation_->stepCount();
     // A gap of more than three report intervals between progress lines is a
@@ -153,12 +170,30 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
 
 void CaseRunner::readRunnerState(const std::string& restartFile) {
     std::ifstream in(restartFile + ".runner");
-    if (!(in >> insertionsDone_ >> placed_ >> nextWaveTime_))
+    long done = -1, placed = -1;
+    if (!(in >> done >> placed >> nextWaveTime_) || done < 0 || placed < 0 || !std::isfinite(nextWaveTime_))
         throw InputError("restart file '" + restartFile + "' has no readable companion '" + restartFile +
-                         ".runner' (insertion progress); expected the pair written by demRun");
-    if (insertionsDone_ > setup_.insertions.size())
-        throw InputError("restart file '" + restartFile + "' records more insertion blocks than the case defines");
-    if (placed_ > 0) population_ = drawPopulation(setup_.insertions[insertionsDone_]);
+                         ".runner' (insertion progress: blocks done, particles placed, next wave time); expected "
+                         "the pair written by demRun");
+    insertionsDone_ = static_cast<std::size_t>(done);
+    placed_ = static_cast<std::size_t>(placed);
+    const std::size_t blocks = setup_.insertions.size();
+    if (insertionsDone_ > blocks || (placed_ > 0 && insertionsDone_ == blocks))
+        throw InputError("restart file '" + restartFile + "' was written " +
+                         (placed_ > 0 ? "in the middle of insertion block " + std::to_string(insertionsDone_ + 1)
+                                      : "after " + std::to_string(insertionsDone_) + " insertion block(s)") +
+                         " (" + restartFile + ".runner), but constant/demProperties now defines " +
+                         std::to_string(blocks) + "; expected the case's insertion blocks as they were (a block " +
+                         "not yet inserted may change)");
+    if (placed_ > 0) {
+        const InsertionSpec& spec = setup_.insertions[insertionsDone_];
+        population_ = drawPopulation(spec);
+        if (placed_ > population_.size())
+            throw InputError(spec.context + ": the restart file '" + restartFile + "' was written after " +
+                             std::to_string(placed_) + " of its particles were placed, but the block now asks for " +
+                             std::to_string(population_.size()) +
+                             "; expected the block being inserted at the restart time unchanged");
+    }
     // Changing the case file between the pieces of a run is allowed (as in OpenFOAM);
     // saying so keeps it from going unnoticed.
     std::string line;
@@ -193,9 +228,14 @@ std::string restartFileFor(const CaseSetup& setup, const std::string& arg, const
     const std::string who = tool.empty() ? std::string() : tool + ": ";
     if (arg == "latest") {
         const std::string file = latestRestartFile(setup);
+        const fs::path dir = fs::path(setup.caseDir) / setup.output.directory / "restart";
+        std::string named;
+        if (file.empty() && (std::ifstream(dir / "latest") >> named))
+            throw InputError(who + "-restart latest: '" + (dir / "latest").string() + "' names '" + named +
+                             "', which is not there; expected a restart file of that folder (give it as "
+                             "-restart FILE)");
         if (file.empty())
-            throw InputError(who + "-restart latest: no restart file found in '" +
-                             (fs::path(setup.caseDir) / setup.output.directory / "restart").string() +
+            throw InputError(who + "-restart latest: no restart file found in '" + dir.string() +
                              "' (run the case first, or give -restart FILE)");
         return file;
     }
@@ -315,11 +355,19 @@ void CaseRunner::writeRestart() {
     name << "restart_" << std::setw(9) << std::setfill('0') << simulation_->stepCount() << ".h5";
     simulation_->writeRestart((dir / name.str()).string());
     {
-        // What the engine's restart file does not know: the insertion progress.
-        std::ofstream state((dir / name.str()).string() + ".runner");
-        state << std::setprecision(17) << insertionsDone_ << " " << placed_ << " " << nextWaveTime_ << "\n";
-        // and the case file it ran with, so that a continued run can say what changed since.
-        state << caseTextMarker << "\n" << caseText_;
+        // What the engine's restart file does not know: the insertion progress, and the
+        // case file it ran with, so that a continued run can say what changed since.  Written
+        // whole or not at all, as the restart file is (a run killed while writing it, or a
+        // full disk, must not leave a cut file that a continued run reads as a changed case).
+        const std::string state = (dir / name.str()).string() + ".runner";
+        {
+            std::ofstream out(state + ".writing");
+            out << std::setprecision(17) << insertionsDone_ << " " << placed_ << " " << nextWaveTime_ << "\n";
+            out << caseTextMarker << "\n" << caseText_;
+            out.flush();
+            if (!out) throw RuntimeError("cannot write '" + state + ".writing' (disk full?)");
+        }
+        fs::rename(state + ".writing", state);
     }
     const fs::path pointer = dir / "latest";
     {

@@ -1,6 +1,7 @@
 #include "demLib/case_setup.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -37,6 +38,17 @@ double availableMemoryBytes() {
     throw InputError(d.describe(key) + ": " + expected);
 }
 
+// Wall and region names become column names of summary.csv (wallForce_<wall>_x,
+// mass_<region>): a comma or a quote in one would shift every column after it.
+void requireColumnName(const Dictionary& d, const std::string& name, const std::string& what) {
+    const bool plain = !name.empty() && std::all_of(name.begin(), name.end(), [](char ch) {
+        return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-' || ch == '.';
+    });
+    if (!plain)
+        invalid(d, name, "a " + what + " name may hold letters, digits, '_', '-' and '.' only (it names columns of "
+                         "summary.csv); expected e.g. 'dieBase'");
+}
+
 // Materials are referred to by name; the message lists the defined ones.
 int materialByName(const Dictionary& d, const std::string& key, const std::vector<Material>& materials) {
     std::vector<std::string> names;
@@ -55,6 +67,7 @@ std::shared_ptr<const TriangleMesh> readStl(const Dictionary& d, const std::stri
     const std::string file = resolve(caseDir, d.get<std::string>("file"));
     const double scale = d.has("scale") ? d.getPositive("scale") : 1.0;
     if (!fs::exists(file)) invalid(d, "file", "the STL file '" + file + "' does not exist");
+    if (!fs::is_regular_file(file)) invalid(d, "file", "'" + file + "' is not a file; expected an STL file");
     return std::make_shared<const TriangleMesh>(TriangleMesh::fromStl(file, scale));
 }
 
@@ -76,6 +89,10 @@ std::shared_ptr<Region> readRegion(const Dictionary& d, const std::string& caseD
         return std::make_shared<Region>(Region::cylinder(point, axis, radius, range[0], range[1]));
     }
     auto mesh = readStl(d, caseDir);
+    // Inside and outside mean nothing for an open surface (docs/walls.md).
+    if (!mesh->isClosed())
+        invalid(d, "file", "the STL surface is open (an edge bounds a single triangle); a region needs a closed "
+                           "surface, expected a closed STL");
     const BoundingBox box = mesh->boundingBox();
     return std::make_shared<Region>(
         Region::predicate([mesh](const Vec3& x) { return mesh->containsPoint(x); }, box.lower, box.upper));
@@ -110,6 +127,7 @@ std::vector<Wall> readWalls(const Dictionary& root, const std::string& caseDir,
     if (!root.has("walls")) return walls;
     const Dictionary& all = root.subDict("walls");
     for (const std::string& name : all.keys()) {
+        requireColumnName(all, name, "wall");
         const Dictionary& d = all.subDict(name);
         const int material = materialByName(d, "material", materials);
         const std::string type = d.getChoice("type", {"plane", "cylinder", "stl"});
@@ -127,7 +145,14 @@ std::vector<Wall> readWalls(const Dictionary& root, const std::string& caseDir,
             return MeshWall(readStl(d, caseDir));
         };
         Wall w{name, shape(), WallMotion(), material};
-        w.motion = readMotion(d);
+        try {
+            w.motion = readMotion(d);
+        } catch (const InputError& e) {
+            // The segments' own checks know neither the file nor the wall.
+            const std::string what = e.what();
+            if (what.rfind("file '", 0) == 0) throw;
+            throw InputError(d.describe("motion") + ": " + what);
+        }
         walls.push_back(std::move(w));
     }
     return walls;
@@ -165,6 +190,13 @@ void checkPopulationSize(const Dictionary& d, const InsertionSpec& spec, const s
     const double count = expectedParticleCount(spec);
     std::ostringstream what;
     what << std::setprecision(3) << "about " << count << " particles";
+    // A mass below that of one particle inserts nothing, silently.
+    if (count < 0.5) {
+        std::ostringstream m;
+        m << std::setprecision(3) << "expected at least the mass of one particle: " << spec.request.targetMass
+          << " kg is " << what.str() << " of the size distribution";
+        invalid(d, key, m.str());
+    }
     // At once (no waves), every particle must fit in the region: not even spheres of the
     // smallest size filling its whole volume reach this count.
     const double dMin = spec.distribution->dMin();
@@ -204,6 +236,8 @@ std::vector<InsertionSpec> readInsertions(const Dictionary& root, const CaseSetu
             if (!(diameter > 0.0)) invalid(d, "diameter", "expected a positive diameter, got " + std::to_string(diameter));
             for (const Vec3& x : d.get<std::vector<Vec3>>("positions"))
                 spec.explicitParticles.push_back({x, 0.5 * diameter * setup.coarseGrain.factor});
+            if (spec.explicitParticles.empty())
+                invalid(d, "positions", "expected a list of at least one position, e.g. ((0 0 0.01))");
             spec.request.initialVelocity = d.getOrDefault<Vec3>("velocity", Vec3::Zero());
             out.push_back(std::move(spec));
             continue;
@@ -375,13 +409,22 @@ CaseSetup readCaseSetup(const Dictionary& root, const std::string& caseDir) {
     if (root.has("output")) {
         const Dictionary& o = root.subDict("output");
         c.output.directory = o.getOrDefault("directory", "dem");
+        const fs::path outDir = fs::path(caseDir) / c.output.directory;
+        std::error_code sameError;
+        if (c.output.directory.find_first_not_of(" \t") == std::string::npos ||
+            fs::equivalent(outDir, caseDir, sameError))
+            invalid(o, "directory", "expected a folder for the results apart from the case folder itself, e.g. 'dem'");
+        if (fs::exists(outDir) && !fs::is_directory(outDir))
+            invalid(o, "directory", "'" + outDir.string() + "' is a file; expected a folder for the results");
         c.output.fieldInterval = o.has("fieldInterval") ? o.getNonNegative("fieldInterval") : 0.0;
         c.output.logInterval = o.has("logInterval") ? o.getNonNegative("logInterval") : 0.0;
         c.output.restartInterval = o.has("restartInterval") ? o.getNonNegative("restartInterval") : 0.0;
         if (o.has("regions")) {
             const Dictionary& regions = o.subDict("regions");
-            for (const std::string& name : regions.keys())
+            for (const std::string& name : regions.keys()) {
+                requireColumnName(regions, name, "region");
                 c.output.regions.push_back({name, readRegion(regions.subDict(name), caseDir)});
+            }
         }
     }
     root.checkNoUnusedKeys();

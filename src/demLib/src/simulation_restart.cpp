@@ -131,6 +131,10 @@ void Simulation::writeRestart(const std::string& path) const {
 void Simulation::readRestart(const std::string& path) {
     requireNoDecomposition("readRestart");
     Hdf5File f(path, Hdf5File::Mode::Read);
+    if (!f.hasAttribute("format"))
+        throw InputError("'" + path + "' is not a restart file (an HDF5 file without the attribute 'format'" +
+                         (f.hasAttribute("step") ? ": a particle output file?" : "") +
+                         "); expected a file of <output>/restart/, e.g. restart_000002000.h5, or 'latest'");
     const std::string format = f.stringAttribute("format");
     if (format != restartFormat)
         throw InputError("restart file '" + path + "': format '" + format + "', expected '" + restartFormat + "'");
