@@ -50,9 +50,8 @@ int main(int argc, char *argv[])
         " (constant/couplingProperties, constant/demProperties)."
     );
 
-    #include "postProcess.H"
-
-    #include "addCheckCaseOptions.H"
+    // No -postProcess and no -dry-run: both would start the DEM (and write
+    // its output over an earlier run's) before they could do anything.
     #include "setRootCaseLists.H"
     #include "createTime.H"
     #include "createMesh.H"

@@ -58,3 +58,22 @@ void Foam::diefill::checkKeywords
         FatalIOError << exit(FatalIOError);
     }
 }
+
+
+Foam::dictionary Foam::diefill::modelCoeffs
+(
+    const dictionary& couplingDict,
+    const word& model
+)
+{
+    const word key(model + "Coeffs");
+    const entry* e = couplingDict.findEntry(key, keyType::LITERAL);
+    if (e && !e->isDict())
+    {
+        FatalIOErrorInFunction(couplingDict)
+            << key << " is not a dictionary; expected " << key
+            << " { ... } with the coefficients of " << model
+            << exit(FatalIOError);
+    }
+    return couplingDict.subOrEmptyDict(key);
+}

@@ -1,4 +1,5 @@
 #include "demCoupling.H"
+#include "dragForce.H"
 #include "checkKeywords.H"
 #include "fvm.H"
 #include "fvc.H"
@@ -90,10 +91,25 @@ Foam::diefill::particleFluidState Foam::diefill::demCoupling::state
 }
 
 
-Foam::label Foam::diefill::demCoupling::demStepsPerFluidStep() const
+void Foam::diefill::demCoupling::checkTimeSteps(scalar demDt) const
 {
+    // The exchange is once per fluid step of a whole number of DEM steps: an
+    // adjusted step would break that at its first change, after the run had
+    // begun writing.
+    if (mesh_.time().controlDict().getOrDefault<Switch>("adjustTimeStep", false))
+    {
+        FatalIOErrorInFunction(mesh_.time().controlDict())
+            << "adjustTimeStep yes: diefillFoam runs with a fixed deltaT,"
+            << " an integer multiple of the DEM time step (simulation/timeStep "
+            << demDt << " s, constant/demProperties); expected"
+            << " adjustTimeStep no" << exit(FatalIOError);
+    }
     const scalar fluidDt = mesh_.time().deltaTValue();
-    const scalar demDt = runner_->simulation().timeStep();
+    if (!(fluidDt > 0))
+    {
+        FatalIOErrorInFunction(mesh_.time().controlDict())
+            << "deltaT must be > 0, got " << fluidDt << exit(FatalIOError);
+    }
     const label n = label(std::round(fluidDt/demDt));
 
     if (n < 1 || mag(n*demDt - fluidDt) > 1e-6*fluidDt)
@@ -104,7 +120,14 @@ Foam::label Foam::diefill::demCoupling::demStepsPerFluidStep() const
             << " DEM time step (simulation/timeStep " << demDt
             << " s, constant/demProperties)." << exit(FatalError);
     }
-    return n;
+}
+
+
+Foam::label Foam::diefill::demCoupling::demStepsPerFluidStep() const
+{
+    const scalar demDt = runner_->simulation().timeStep();
+    checkTimeSteps(demDt);
+    return label(std::round(mesh_.time().deltaTValue()/demDt));
 }
 
 
@@ -172,7 +195,17 @@ Foam::diefill::demCoupling::demCoupling
             << exit(FatalIOError);
     }
 
-    // Air viscosity: laminar transport, uniform (Newtonian)
+    // Air viscosity: laminar transport, uniform (Newtonian).  A zero or
+    // negative nu or rho ended in a floating point exception (or a bead
+    // falling at -667 m/s) instead of an error.
+    const scalar nuMin = gMin(transport.nu()().primitiveField());
+    if (!(rho_ > 0) || !(nuMin > 0))
+    {
+        FatalErrorInFunction
+            << "constant/transportProperties: the air needs rho > 0 [kg/m3]"
+            << " and nu > 0 [m2/s], got rho " << rho_ << ", nu " << nuMin
+            << exit(FatalError);
+    }
     mu_ = rho_*gMax(transport.nu()().primitiveField());
 
     voidFraction_ = voidFractionModel::New
@@ -182,11 +215,40 @@ Foam::diefill::demCoupling::demCoupling
         dict_
     );
 
+    // Each model once, and one drag law: two are added (a repeated or a
+    // second law doubled the drag without a word); none couples nothing.
     const wordList forceNames(dict_.get<wordList>("forceModels"));
+    if (forceNames.empty())
+    {
+        FatalIOErrorInFunction(dict_)
+            << "forceModels is empty; expected a drag law and, usually,"
+            << " pressureGradient, e.g. (GidaspowErgunWenYu pressureGradient);"
+            << " models: "
+            << particleForce::dictionaryConstructorTablePtr_->sortedToc()
+            << exit(FatalIOError);
+    }
     forces_.setSize(forceNames.size());
+    word dragName;
     forAll(forceNames, i)
     {
+        if (forceNames.find(forceNames[i]) != i)
+        {
+            FatalIOErrorInFunction(dict_)
+                << "forceModels names " << forceNames[i] << " twice;"
+                << " expected each model once" << exit(FatalIOError);
+        }
         forces_.set(i, particleForce::New(forceNames[i], dict_));
+        if (isA<dragForce>(forces_[i]))
+        {
+            if (!dragName.empty())
+            {
+                FatalIOErrorInFunction(dict_)
+                    << "forceModels holds two drag laws, " << dragName
+                    << " and " << forceNames[i] << "; expected one"
+                    << exit(FatalIOError);
+            }
+            dragName = forceNames[i];
+        }
     }
 
     // Every keyword is one the solver reads; a <model>Coeffs block of a model
@@ -227,6 +289,10 @@ Foam::diefill::demCoupling::demCoupling
             << "Reading the DEM case " << caseDir/"constant/demProperties"
             << " failed:" << nl << "    " << e.what() << exit(FatalError);
     }
+
+    // The time steps are checked before the DEM starts and opens its output:
+    // a refused run leaves the results of an earlier one as they were.
+    checkTimeSteps(setup.settings.timeStep);
 
     if (setup.endTime < mesh_.time().endTime().value() - SMALL)
     {

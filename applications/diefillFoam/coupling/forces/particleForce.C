@@ -1,4 +1,5 @@
 #include "particleForce.H"
+#include "checkKeywords.H"
 
 namespace Foam
 {
@@ -38,6 +39,6 @@ Foam::autoPtr<Foam::diefill::particleForce> Foam::diefill::particleForce::New
 
     return autoPtr<particleForce>
     (
-        cstrIter()(couplingDict.subOrEmptyDict(name + "Coeffs"))
+        cstrIter()(modelCoeffs(couplingDict, name))
     );
 }

@@ -1,4 +1,5 @@
 #include "voidFractionModel.H"
+#include "checkKeywords.H"
 
 namespace Foam
 {
@@ -86,6 +87,6 @@ Foam::diefill::voidFractionModel::New
 
     return autoPtr<voidFractionModel>
     (
-        cstrIter()(mesh, couplingDict.subOrEmptyDict(name + "Coeffs"))
+        cstrIter()(mesh, modelCoeffs(couplingDict, name))
     );
 }
