@@ -324,7 +324,42 @@ Foam::diefill::demCoupling::demCoupling
     dem::RunOptions options;
     options.progressInterval = 0;
     const scalar startTime = mesh_.time().startTime().value();
-    if (startTime > 0)
+    if (startTime <= 0)
+    {
+        // A new run in a case that holds a run already would overwrite part of
+        // it and keep the rest: the later time folders and DEM restart files of
+        // the old run, which a continuation would then take up with the new
+        // inputs.
+        DynamicList<word> later;
+        for (const instant& t : mesh_.time().times())
+        {
+            if (t.value() > startTime) later.append(t.name());
+        }
+        const fileName demLatest =
+            caseDir/fileName(setup.output.directory)/"restart"/"latest";
+        if (later.size() || isFile(demLatest))
+        {
+            std::string found;
+            for (const word& t : later)
+            {
+                found += (found.empty() ? "time folders " : " ") + t;
+            }
+            if (isFile(demLatest))
+            {
+                found += std::string(found.empty() ? "" : ", ")
+                    + "DEM restart files in " + setup.output.directory + "/restart";
+            }
+            FatalErrorInFunction
+                << "The case holds the results of an earlier run (" << found.c_str()
+                << "); a new run from t = " << startTime << " would overwrite"
+                << " part of it and leave the rest." << nl
+                << "    Expected a case without them: continue the run with"
+                << " startFrom latestTime (system/controlDict), or remove them"
+                << " first (foamListTimes -rm; rm -r "
+                << setup.output.directory << ")." << exit(FatalError);
+        }
+    }
+    else
     {
         // The DEM restart file of the step at the air's start time (demLib
         // names them restart_<step>.h5), not merely the newest one: a run
