@@ -2,16 +2,26 @@
 #
 #   tutorial_parse_args "$@"    sets QUICK (0/1), ROLLING (cdt|epsd2|epsd|none or empty = as in the file),
 #                               THREADS (default 1: on a shared 2-core machine one thread is several
-#                               times faster than two); prints the usage from the caller's header on -help
+#                               times faster than two); prints the usage from the caller's header on -help.
+#                               A case's own flags: the caller's tutorial_case_option FLAG returns 0
+#                               when it took FLAG.  A missing or bad value (an option given as the
+#                               value: -rolling -dry) stops it with one line, exit 2, nothing written
 #   tutorial_prepare [EXTRA]    constant/demProperties from constant/demProperties.orig (saved on the
 #                               first run) with the '// @quick ...' lines swapped in (-quick) and
 #                               'rolling <model>' set (-rolling); first checks the case with
 #                               tutorial_guard (VARIANT: "quick|full, rolling MODEL" + EXTRA)
 #   tutorial_guard              stops Allrun (exit 2) before it writes anything when the case holds
-#                               results of another variant or of other inputs, or when the generated
-#                               constant/demProperties was edited by hand (Allrun would overwrite it)
-#   tutorial_record             writes constant/runRecord (variant, checksums of demProperties.orig and of
-#                               the generated demProperties and system/controlDict) just before the solver runs
+#                               results of another variant or of other inputs (a file of tutorial_inputs
+#                               changed, added or removed since the run), or when the generated
+#                               constant/demProperties or system/controlDict was edited by hand (Allrun
+#                               would overwrite it)
+#   tutorial_inputs             the case's inputs, one a line: every file in constant/, system/ and 0.orig/
+#                               and the case's geometry writers, less the files Allrun generates
+#                               (TUTORIAL_GENERATED; the generated demProperties and controlDict are
+#                               checked against their sources, constant/demProperties.orig and
+#                               system/controlDict.orig, which are inputs)
+#   tutorial_record             writes constant/runRecord (variant, checksums of the inputs and of the
+#                               generated demProperties and system/controlDict) just before the solver runs
 #   tutorial_run_demRun         demRun (or $DEMRUN) in the case (log.demRun); continues from the newest
 #                               restart file when there is one (same variant and inputs: tutorial_guard);
 #                               wall time in TUTORIAL_DEM_SECONDS, and TUTORIAL_RUNTIME_ARGS = (-runTime S)
@@ -36,26 +46,42 @@ tutorial_usage() {
     awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$script"
 }
 
+# _tutorial_value OPTION WHAT "$@": stops (one line, exit 2) when OPTION has no value: none
+# follows it, or the next word is an option (-dry, -quick: not a value; -1 is one, refused later).
+_tutorial_value() {
+    local option=$1 what=$2
+    shift 2
+    if [ $# -lt 2 ] || [[ "$2" =~ ^-[a-zA-Z] ]]; then
+        echo "$(basename "$0"): $option needs $what${2+ (got the option '$2')}" >&2
+        exit 2
+    fi
+}
+
 tutorial_parse_args() {
     QUICK=0; ROLLING=""; THREADS=1
     while [ $# -gt 0 ]; do
         case "$1" in
             -quick) QUICK=1 ;;
             -rolling)
-                ROLLING=${2:?-rolling needs a model: cdt, epsd2, epsd or none}; shift
+                _tutorial_value -rolling "a model: cdt, epsd2, epsd or none" "$@"
+                ROLLING=$2; shift
                 case "$ROLLING" in cdt|epsd|epsd2|none) ;; *)
                     echo "$(basename "$0"): unknown rolling model '$ROLLING'; expected cdt, epsd2, epsd or none" >&2
                     exit 2 ;;
                 esac ;;
             -threads)
-                THREADS=${2:?-threads needs a number}; shift
+                _tutorial_value -threads "a positive whole number" "$@"
+                THREADS=$2; shift
                 # Checked here, before anything is written into the case.
                 case "$THREADS" in ''|*[!0-9]*|0*)
                     echo "$(basename "$0"): -threads expects a positive whole number, got '$THREADS'" >&2
                     exit 2 ;;
                 esac ;;
             -h|-help|--help) tutorial_usage; exit 0 ;;
-            *) echo "$(basename "$0"): unknown option '$1'" >&2; tutorial_usage >&2; exit 2 ;;
+            *)
+                if declare -F tutorial_case_option > /dev/null && tutorial_case_option "$1"; then :; else
+                    echo "$(basename "$0"): unknown option '$1'" >&2; tutorial_usage >&2; exit 2
+                fi ;;
         esac
         shift
     done
@@ -83,11 +109,48 @@ tutorial_variant() {
 _tutorial_md5() { md5sum < "$1" | cut -d' ' -f1; }
 _tutorial_recorded() { sed -n "s/^$1 //p" constant/runRecord 2> /dev/null; }
 
+# Files Allrun (or what it runs: writeAirMesh, the solver's start) writes into constant/ and system/.
+TUTORIAL_AIR_DICTS=(system/blockMeshDict system/topoSetDict system/topoSetDict.aeration system/createPatchDict)
+TUTORIAL_GENERATED=(constant/demProperties system/controlDict constant/setting constant/air constant/runRecord
+                    "${TUTORIAL_AIR_DICTS[@]}")
+
+# The inputs a run reads, or makes what it reads from (the geometry and the air mesh): a continued
+# run would read a changed one differently, so the guard refuses it (one list for all the cases).
+tutorial_inputs() {
+    local f
+    for f in constant/* system/* 0.orig/* writeGeometry writeAirMesh; do
+        [ -f "$f" ] || continue
+        case " ${TUTORIAL_GENERATED[*]} " in *" $f "*) continue ;; esac
+        echo "$f"
+    done
+}
+
+# The inputs changed since constant/runRecord was written, as 'FILE was changed|added|removed, ...'.
+# A record without inputs (written before they were recorded) has demProperties.orig's only.
+_tutorial_changed_inputs() {
+    local f md5 changes=() recorded
+    recorded=$(sed -n 's/^input //p' constant/runRecord)
+    if [ -z "$recorded" ]; then
+        if [ -f constant/demProperties.orig ] && [ "$(_tutorial_md5 constant/demProperties.orig)" != "$(_tutorial_recorded source)" ]; then
+            changes+=("constant/demProperties.orig was changed")
+        fi
+    else
+        while read -r md5 f; do
+            if [ ! -f "$f" ]; then changes+=("$f was removed")
+            elif [ "$(_tutorial_md5 "$f")" != "$md5" ]; then changes+=("$f was changed"); fi
+        done <<< "$recorded"
+        while read -r f; do
+            [ -z "$f" ] || grep -qxF -- "$f" <<< "$(cut -d' ' -f2- <<< "$recorded")" || changes+=("$f was added")
+        done <<< "$(tutorial_inputs)"
+    fi
+    [ ${#changes[@]} = 0 ] || { local IFS=,; echo "${changes[*]}" | sed 's/,/, /g'; }
+}
+
 # Results of a run: DEM output or air time folders.
 tutorial_has_results() { [ -f dem/summary.csv ] || [ -f dem/restart/latest ] || [ -n "$(tutorial_air_times)" ]; }
 
 tutorial_guard() {
-    local props=constant/demProperties me recorded
+    local props=constant/demProperties me recorded changed
     me=$(basename "$0")
     [ -f constant/runRecord ] || return 0     # never run, or cleaned, or run before the record existed
     if [ -f "$props.orig" ] && [ "$(_tutorial_md5 "$props")" != "$(_tutorial_recorded generated)" ]; then
@@ -110,10 +173,11 @@ tutorial_guard() {
              "mix or delete them; nothing done. Run ./Allclean first, or run in a fresh copy of the tutorial." >&2
         exit 2
     fi
-    if [ -f "$props.orig" ] && [ "$(_tutorial_md5 "$props.orig")" != "$(_tutorial_recorded source)" ]; then
-        echo "$me: constant/demProperties.orig was changed after this case's results were computed: Allrun" \
-             "would continue them with other inputs; nothing done. Run ./Allclean first (the results go)," \
-             "or run in a fresh copy of the case." >&2
+    changed=$(_tutorial_changed_inputs)
+    if [ -n "$changed" ]; then
+        echo "$me: $changed after this case's results were computed: Allrun would continue them with other" \
+             "inputs; nothing done. Undo the change, or run ./Allclean first (the results go), or run in a" \
+             "fresh copy of the case." >&2
         exit 2
     fi
 }
@@ -122,6 +186,10 @@ tutorial_record() {
     printf 'variant %s\nsource %s\ngenerated %s\n' "$VARIANT" "$(_tutorial_md5 constant/demProperties.orig)" \
         "$(_tutorial_md5 constant/demProperties)" > constant/runRecord
     [ ! -f system/controlDict.orig ] || printf 'controlDict %s\n' "$(_tutorial_md5 system/controlDict)" >> constant/runRecord
+    local f
+    while read -r f; do
+        [ -z "$f" ] || printf 'input %s %s\n' "$(_tutorial_md5 "$f")" "$f" >> constant/runRecord
+    done <<< "$(tutorial_inputs)"
 }
 
 tutorial_prepare() {
@@ -223,8 +291,7 @@ tutorial_clean_args() {
 }
 
 tutorial_clean_air() {
-    rm -rf 0 constant/polyMesh [1-9]* 0.[0-9]* processor* postProcessing log.* case.foam \
-        system/blockMeshDict system/topoSetDict system/topoSetDict.aeration system/createPatchDict
+    rm -rf 0 constant/polyMesh [1-9]* 0.[0-9]* processor* postProcessing log.* case.foam "${TUTORIAL_AIR_DICTS[@]}"
     [ -f system/controlDict.orig ] && mv system/controlDict.orig system/controlDict
     return 0
 }
