@@ -96,8 +96,10 @@ def main():
     if f.time < removed_at:
         print(f"    warning: the last output (t = {f.time:.3f} s) is before the tube is removed ({removed_at} s)")
     print(f"    repose angle ({setting}, rolling {rolling}): {fit['angle']:.1f} deg (paper 28 deg), "
-          f"fit over r = {fit['window'][0]*1e3:.1f}-{fit['window'][1]*1e3:.1f} mm, sectors "
-          f"{np.mean(sector_angles):.1f} +- {np.std(sector_angles):.1f} deg; pile height {peak*1e3:.1f} mm, "
+          f"fit over r = {fit['window'][0]*1e3:.1f}-{fit['window'][1]*1e3:.1f} mm, "
+          + (f"sectors {np.mean(sector_angles):.1f} +- {np.std(sector_angles):.1f} deg" if sector_angles
+             else "no sector alone holds enough of the flank for a fit")
+          + f"; pile height {peak*1e3:.1f} mm, "
           f"{f.count} particles, {f.total_mass*1e3:.2f} g")
     print(f"    results: {jp}")
 
