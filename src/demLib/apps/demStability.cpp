@@ -133,7 +133,7 @@ int main(int argc, char** argv) {
             throw dem::InputError("demStability: the restart file '" + restart +
                                   "' holds no particle; expected a bed to analyse");
         const dem::BedStabilityReport r = dem::analyseBedStability(*sim, options);
-        if (r.particles == 0 && !sim->particles().empty())
+        if (r.particles == 0)  // the bed has particles (checked above): none in -region
             throw dem::InputError("demStability: -region holds no particle centre of the bed (expected a box "
                                   "around some of its " + std::to_string(sim->particles().size()) + " particles)");
         std::cout << std::setprecision(4) << r.particles << " particles analysed (of " << sim->particles().size()

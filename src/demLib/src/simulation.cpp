@@ -5,6 +5,7 @@
 #include <limits>
 #include <sstream>
 
+#include "demLib/cell_bins.hpp"
 #include "demLib/constants.hpp"
 #include "demLib/contact_stability.hpp"
 #include "demLib/error.hpp"
@@ -50,48 +51,39 @@ void requireTimeStepBelow(const SimulationSettings& settings, const Simulation::
 // list with a typo) would be shot apart by a huge force, or lost: the first pair
 // overlapping by more than half the smaller radius is refused.  Beds taken from
 // settled runs overlap less: about one per cent of the radius under 1 g, up to 16 %
-// for the small grains of the polydisperse bench bed pressed under 4 g.  New particles are checked
-// against each other and against those already in the simulation, through a sorted
-// list of cell keys (16 bytes a particle for the check's duration).
+// for the small grains of the polydisperse bench bed pressed under 4 g.  New particles
+// are checked against each other and against those already in the simulation, in the
+// linked cells the neighbour search uses (cell_bins).
 void requireNoDeepOverlap(const std::vector<InsertedParticle>& inserted, const ParticleStore& existing,
                           const std::string& context) {
     if (inserted.empty()) return;
-    double largest = 0.0;
-    for (const InsertedParticle& q : inserted) largest = std::max(largest, q.radius);
-    for (std::size_t i = 0; i < existing.size(); ++i) largest = std::max(largest, existing.radius[i]);
-    const double cell = 2.0 * largest;
-    const auto key = [cell](const Vec3& x, int dx, int dy, int dz) {
-        const auto c = [cell](double v, int d) { return static_cast<std::int64_t>(std::floor(v / cell)) + d; };
-        return (c(x.x(), dx) * 73856093) ^ (c(x.y(), dy) * 19349663) ^ (c(x.z(), dz) * 83492791);
-    };
-    // (cell key, particle): existing particles as -1 - index, inserted ones as their index.
-    std::vector<std::pair<std::int64_t, long>> cells;
-    cells.reserve(existing.size() + inserted.size());
-    for (std::size_t i = 0; i < existing.size(); ++i)
-        cells.emplace_back(key(existing.position[i], 0, 0, 0), -1 - static_cast<long>(i));
-    for (std::size_t k = 0; k < inserted.size(); ++k)
-        cells.emplace_back(key(inserted[k].position, 0, 0, 0), static_cast<long>(k));
-    std::sort(cells.begin(), cells.end());
-    for (std::size_t k = 0; k < inserted.size(); ++k) {
-        const InsertedParticle& q = inserted[k];
-        for (int dx = -1; dx <= 1; ++dx)
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dz = -1; dz <= 1; ++dz) {
-                    const std::int64_t near = key(q.position, dx, dy, dz);
-                    auto it = std::lower_bound(cells.begin(), cells.end(), std::make_pair(near, std::numeric_limits<long>::min()));
-                    for (; it != cells.end() && it->first == near; ++it) {
-                        const long other = it->second;
-                        if (other >= static_cast<long>(k)) continue;  // itself, or a later one (checked from there)
-                        const bool isNew = other >= 0;
-                        const Vec3& x = isNew ? inserted[other].position : existing.position[-1 - other];
-                        const double r = isNew ? inserted[other].radius : existing.radius[-1 - other];
-                        const double overlap = q.radius + r - (q.position - x).norm();
-                        if (!(overlap > 0.5 * std::min(q.radius, r))) continue;
-                        throw InputError(context + ": particle " + std::to_string(k) + " at " + formatVec(q.position) +
-                                         " (radius " + std::to_string(q.radius) + ") overlaps " +
-                                         (isNew ? "particle " + std::to_string(other) + " of the same insertion"
-                                                : std::string("a particle already in the simulation")) +
-                                         " at " + formatVec(x) + " by " + std::to_string(overlap) +
+    // Existing particles first, then the new ones: index i >= before is new particle i - before.
+    const std::size_t before = existing.size();
+    std::vector<Vec3> position(existing.position);
+    std::vector<double> radius(existing.radius);
+    for (const InsertedParticle& q : inserted) {
+        position.push_back(q.position);
+        radius.push_back(q.radius);
+    }
+    const CellBins bins = binIntoCells(position, 2.0 * *std::max_element(radius.begin(), radius.end()));
+    for (std::size_t i = before; i < position.size(); ++i) {
+        const int cell = bins.cellOf[i];
+        const int cx = cell % bins.nx, cy = (cell / bins.nx) % bins.ny, cz = cell / (bins.nx * bins.ny);
+        for (int z = std::max(cz - 1, 0); z <= std::min(cz + 1, bins.nz - 1); ++z)
+            for (int y = std::max(cy - 1, 0); y <= std::min(cy + 1, bins.ny - 1); ++y)
+                for (int x = std::max(cx - 1, 0); x <= std::min(cx + 1, bins.nx - 1); ++x) {
+                    const int neighbour = (z * bins.ny + y) * bins.nx + x;
+                    for (int e = bins.cellStart[neighbour]; e < bins.cellStart[neighbour + 1]; ++e) {
+                        const std::size_t j = static_cast<std::size_t>(bins.particles[e]);
+                        if (j >= i) continue;  // itself, or a later new one (checked from there)
+                        const double overlap = radius[i] + radius[j] - (position[i] - position[j]).norm();
+                        if (!(overlap > 0.5 * std::min(radius[i], radius[j]))) continue;
+                        throw InputError(context + ": particle " + std::to_string(i - before) + " at " +
+                                         formatVec(position[i]) + " (radius " + std::to_string(radius[i]) +
+                                         ") overlaps " +
+                                         (j >= before ? "particle " + std::to_string(j - before) + " of the same insertion"
+                                                      : std::string("a particle already in the simulation")) +
+                                         " at " + formatVec(position[j]) + " by " + std::to_string(overlap) +
                                          " m; expected particles at most half the smaller radius into each other");
                     }
                 }
