@@ -47,7 +47,12 @@ def main():
     f = frame_at(a.case, a.time)
     bw = a.binWidth if a.binWidth is not None else 1.5 * float(np.mean(2 * f.radius))
     if a.line:
-        x, h = profile.line_profile(f.position, f.radius, a.line[:3], a.line[3:], a.up, bw, band=a.band)
+        try:
+            x, h = profile.line_profile(f.position, f.radius, a.line[:3], a.line[3:], a.up, bw, band=a.band)
+        except ValueError as e:
+            if a.band is None:
+                raise
+            raise ValueError(f"argument -band: {e} given by -line (widen -band, or move -line onto the bed)") from e
     else:
         x, h, _ = profile.radial_profile(f.position, f.radius, a.axis[:3], a.axis[3:], bw, sectors=a.sectors)
     fit = None

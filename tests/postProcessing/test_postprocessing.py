@@ -405,6 +405,7 @@ def bad_option_values_are_refused():
         ("bedProfile.py", line + ["-binWidth", 0], "-binWidth"),
         ("bedProfile.py", line + ["-binWidth", "nan"], "-binWidth"),
         ("bedProfile.py", line + ["-band", 0], "-band"),
+        ("bedProfile.py", ["-line", 0, 5, 0, 1, 0, 0, "-band", 1e-6], "-band"),
         ("bedProfile.py", line + ["-time", "nan"], "-time"),
         ("bedProfile.py", line + ["-window", 5, 2], "-window"),
         ("bedProfile.py", line + ["-window", "auto", "x"], "-window"),
