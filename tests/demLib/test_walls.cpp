@@ -925,3 +925,37 @@ TEST(Wall, LiftedCylinderMovesWithItsMotion) {
     expectVectorNear(box.lower, Vec3(-0.0215, -0.0215, 0.01), 1e-15);
     expectVectorNear(box.upper, Vec3(0.0215, 0.0215, 0.06), 1e-15);
 }
+
+// The fastest wall material of each motion segment (case setup refuses a wall
+// faster than impactVelocity): |v| of a translation; |omega| x the farthest
+// point from the axis of a rotation, a mesh by its vertices, and no farther
+// than the domain's corners; a turning plane without a domain is unbounded.
+TEST(Wall, LargestSpeedOfEachMotionSegment) {
+    dem::Wall plate{"plate", dem::MeshWall(std::make_shared<const dem::TriangleMesh>(squareTriangles(1.0, 1))),
+                    dem::WallMotion(), 1};
+    plate.motion.addTranslation(0.0, 1.0, Vec3(3.0, 4.0, 0.0));
+    // Turns about the y axis through (2, 0, 0) after the unit square (x, y in [0, 1], z = 0) moved
+    // by (3, 4, 0): its vertices lie 1 to 2 from the axis in x, so the farthest is 2 away.
+    plate.motion.addRotation(2.0, 3.0, Vec3(2.0, 0.0, 0.0), Vec3(0.0, 1.0, 0.0), 0.5);
+    EXPECT_DOUBLE_EQ(plate.largestSpeed(0, nullptr), 5.0);
+    EXPECT_DOUBLE_EQ(plate.largestSpeed(1, nullptr), 0.5 * 2.0);
+    // A domain whose farthest corner lies 1.5 from the axis bounds it.
+    const dem::AxisAlignedBox domain{Vec3(2.5, -1.0, -1.0), Vec3(3.5, 1.0, 1.0)};
+    EXPECT_DOUBLE_EQ(plate.largestSpeed(1, &domain), 0.5 * std::hypot(1.5, 1.0));
+    // Removed before the turn starts: it moves nothing.
+    plate.motion.setRemovalTime(1.5);
+    EXPECT_EQ(plate.largestSpeed(1, nullptr), 0.0);
+
+    dem::Wall floor{"floor", dem::PlaneWall(Vec3(0, 0, 0), Vec3(0, 0, 1)), dem::WallMotion(), 0};
+    floor.motion.addRotation(0.0, 1.0, Vec3(0, 0, 0), Vec3(1, 0, 0), -2.0);
+    EXPECT_TRUE(std::isinf(floor.largestSpeed(0, nullptr)));
+    const dem::AxisAlignedBox cube{Vec3(-1, -1, -1), Vec3(1, 1, 1)};
+    EXPECT_DOUBLE_EQ(floor.largestSpeed(0, &cube), 2.0 * std::sqrt(2.0));
+
+    // A tube of radius 0.5 around the z axis turning about the x axis: its box's
+    // corners (+-0.5, +-0.5, 0 or 2) lie up to hypot(0.5, 2) from it.
+    dem::Wall tube{"tube", dem::CylinderWall(Vec3(0, 0, 0), Vec3(0, 0, 1), 0.5, 0.0, 2.0, dem::CylinderWall::Side::Inside),
+                   dem::WallMotion(), 0};
+    tube.motion.addRotation(0.0, 1.0, Vec3(0, 0, 0), Vec3(1, 0, 0), 3.0);
+    EXPECT_DOUBLE_EQ(tube.largestSpeed(0, nullptr), 3.0 * std::hypot(0.5, 2.0));
+}

@@ -121,8 +121,36 @@ WallMotion readMotion(const Dictionary& wall) {
     return motion;
 }
 
+// A wall whose material moves faster than impactVelocity hits particles faster
+// than the time step was checked for (the Hertz collision time shortens with the
+// impact speed; Simulation::timeStepLimits): e.g. a velocity typed in mm/s as m/s.
+void requireWallSpeedsChecked(const Dictionary& wall, const Wall& w, const SimulationSettings& settings) {
+    if (settings.allowLargeTimeStep || !wall.has("motion")) return;
+    const Dictionary& motion = wall.subDict("motion");
+    const std::vector<std::string> segments = motion.keys();  // in the order readMotion added them
+    const AxisAlignedBox* domain = settings.domain ? &*settings.domain : nullptr;
+    for (std::size_t k = 0; k < w.motion.segments().size() && k < segments.size(); ++k) {
+        const double speed = w.largestSpeed(k, domain);
+        if (!(speed > settings.impactVelocity)) continue;
+        const bool turns = w.motion.segments()[k].kind == MotionSegment::Kind::Rotate;
+        std::ostringstream e;
+        e.precision(6);
+        if (turns && !std::isfinite(speed))
+            e << "a turning plane reaches arbitrarily far from its axis, where it moves faster than 'impactVelocity' ("
+              << settings.impactVelocity << " m/s, the largest particle speed the time step is checked for); "
+              << "expected a simulation 'domain' box (particles touch the plane only inside it)";
+        else
+            e << (turns ? "the wall's point farthest from the axis moves at " : "the wall moves at ") << speed
+              << " m/s, faster than 'impactVelocity' (" << settings.impactVelocity
+              << " m/s in simulation, the largest particle speed the time step is checked for); expected a "
+              << (turns ? "slower turn" : "speed") << " <= impactVelocity, or impactVelocity >= " << speed
+              << " (the time step is then checked for impacts at that speed)";
+        invalid(motion.subDict(segments[k]), turns ? "angularVelocity" : "velocity", e.str());
+    }
+}
+
 std::vector<Wall> readWalls(const Dictionary& root, const std::string& caseDir,
-                            const std::vector<Material>& materials) {
+                            const std::vector<Material>& materials, const SimulationSettings& settings) {
     std::vector<Wall> walls;
     if (!root.has("walls")) return walls;
     const Dictionary& all = root.subDict("walls");
@@ -153,6 +181,7 @@ std::vector<Wall> readWalls(const Dictionary& root, const std::string& caseDir,
             if (what.rfind("file '", 0) == 0) throw;
             throw InputError(d.describe("motion") + ": " + what);
         }
+        requireWallSpeedsChecked(d, w, settings);
         walls.push_back(std::move(w));
     }
     return walls;
@@ -403,7 +432,7 @@ CaseSetup readCaseSetup(const Dictionary& root, const std::string& caseDir) {
         throw InputError(inter.describe("") + ": " + e.what());
     }
 
-    c.walls = readWalls(root, caseDir, c.materials);
+    c.walls = readWalls(root, caseDir, c.materials, c.settings);
     c.insertions = readInsertions(root, c);
 
     if (root.has("output")) {

@@ -1,6 +1,9 @@
 #include "demLib/wall.hpp"
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <limits>
 
 namespace dem {
 
@@ -44,7 +47,44 @@ BoundingBox transformed(const BoundingBox& box, const RigidTransform& pose) {
     return result;
 }
 
+double distanceFromAxis(const Vec3& point, const Vec3& axisPoint, const Vec3& unitAxis) {
+    const Vec3 d = point - axisPoint;
+    return (d - d.dot(unitAxis) * unitAxis).norm();
+}
+
+double farthestCornerFromAxis(const Vec3& lower, const Vec3& upper, const Vec3& axisPoint, const Vec3& unitAxis) {
+    double farthest = 0.0;
+    for (int corner = 0; corner < 8; ++corner) {
+        const Vec3 p((corner & 1) ? upper.x() : lower.x(), (corner & 2) ? upper.y() : lower.y(),
+                     (corner & 4) ? upper.z() : lower.z());
+        farthest = std::max(farthest, distanceFromAxis(p, axisPoint, unitAxis));
+    }
+    return farthest;
+}
+
 }  // namespace
+
+double Wall::largestSpeed(std::size_t k, const AxisAlignedBox* domain) const {
+    const MotionSegment& segment = motion.segments().at(k);
+    if (!isActive(segment.tStart)) return 0.0;
+    if (segment.kind == MotionSegment::Kind::Translate) return segment.velocity.norm();
+    // A point's distance from the axis stays while the wall turns about it:
+    // take the wall where the segment starts.
+    const Vec3& axisPoint = segment.axisPoint;
+    const Vec3& axis = segment.axisDirection;
+    double reach = std::numeric_limits<double>::infinity();
+    if (const auto* mesh = std::get_if<MeshWall>(&shape)) {
+        const RigidTransform pose = motion.at(segment.tStart);
+        reach = 0.0;
+        for (const Vec3& vertex : mesh->mesh().vertices())
+            reach = std::max(reach, distanceFromAxis(pose.apply(vertex), axisPoint, axis));
+    } else if (std::holds_alternative<CylinderWall>(shape)) {
+        const BoundingBox box = boundingBox(segment.tStart);
+        reach = farthestCornerFromAxis(box.lower, box.upper, axisPoint, axis);
+    }
+    if (domain) reach = std::min(reach, farthestCornerFromAxis(domain->min, domain->max, axisPoint, axis));
+    return std::abs(segment.angularVelocity) * reach;
+}
 
 BoundingBox Wall::boundingBox(double time) const {
     if (!isActive(time)) {

@@ -9,6 +9,7 @@
 #include <variant>
 #include <vector>
 
+#include "demLib/axis_aligned_box.hpp"
 #include "demLib/triangle_mesh.hpp"
 #include "demLib/vec3.hpp"
 #include "demLib/wall_contact.hpp"
@@ -45,6 +46,15 @@ struct Wall {
     bool enclosesPoint(const Vec3& point, double time) const;
 
     bool isActive(double time) const { return motion.isActive(time); }
+
+    // The largest speed of the wall's material during motion segment k
+    // (motion.segments()[k]), 0 if the wall is removed before it starts: |v|
+    // for a translation; for a rotation |omega| times the largest distance from
+    // the axis of a point of the wall (a mesh's vertices, the corners of a
+    // cylinder's box), and no farther than the corners of `domain` when given
+    // (particles touch the wall only there).  Infinite for a rotating plane
+    // without a domain: its material reaches arbitrarily far.
+    double largestSpeed(std::size_t k, const AxisAlignedBox* domain) const;
 };
 
 }  // namespace dem
