@@ -52,34 +52,25 @@ std::vector<LinearisedContact> bedContacts(const Simulation& sim, const BedStabi
     const CellBins bins = binIntoCells(p.position, 2.0 * *std::max_element(p.radius.begin(), p.radius.end()));
     std::vector<WallContact> found;
     for (const int i : inside) {
-        const int cell = bins.cellOf[i];
-        const int cx = cell % bins.nx, cy = (cell / bins.nx) % bins.ny, cz = cell / (bins.nx * bins.ny);
-        for (int z = std::max(cz - 1, 0); z <= std::min(cz + 1, bins.nz - 1); ++z)
-            for (int y = std::max(cy - 1, 0); y <= std::min(cy + 1, bins.ny - 1); ++y)
-                for (int x = std::max(cx - 1, 0); x <= std::min(cx + 1, bins.nx - 1); ++x) {
-                    const int neighbour = (z * bins.ny + y) * bins.nx + x;
-                    for (int e = bins.cellStart[neighbour]; e < bins.cellStart[neighbour + 1]; ++e) {
-                        const int j = bins.particles[e];
-                        if (j == i || (local[j] >= 0 && j < i)) continue;  // a pair inside once
-                        const Vec3 d = p.position[j] - p.position[i];
-                        const double dist = d.norm();
-                        const double overlap = p.radius[i] + p.radius[j] - dist;
-                        if (!(overlap > 0.0)) continue;
-                        const double radiusEff = p.radius[i] * p.radius[j] / (p.radius[i] + p.radius[j]);
-                        const double massEff = p.mass[i] * p.mass[j] / (p.mass[i] + p.mass[j]);
-                        LinearisedContact k;
-                        k.i = local[i];
-                        k.j = local[j];  // -1 outside: held fixed
-                        k.normal = d / dist;
-                        k.leverI = p.radius[i] - 0.5 * overlap;
-                        k.leverJ = p.radius[j] - 0.5 * overlap;
-                        k.law = linearHertzContact(sim.interactions()(p.material[i], p.material[j]), radiusEff,
-                                                   massEff, overlap, rolling,
-                                                   rollingInertiaEff(p.mass[i], p.radius[i], p.mass[j], p.radius[j]));
-                        k.fixedParticle = local[j] < 0;
-                        contacts.push_back(k);
-                    }
-                }
+        forEachInNeighbouringCells(bins, i, [&](int j) {
+            if (j == i || (local[j] >= 0 && j < i)) return;  // a pair inside once
+            const Vec3 d = p.position[j] - p.position[i];
+            const double dist = d.norm();
+            const double overlap = p.radius[i] + p.radius[j] - dist;
+            if (!(overlap > 0.0)) return;
+            const double radiusEff = p.radius[i] * p.radius[j] / (p.radius[i] + p.radius[j]);
+            const double massEff = p.mass[i] * p.mass[j] / (p.mass[i] + p.mass[j]);
+            LinearisedContact k;
+            k.i = local[i];
+            k.j = local[j];  // -1 outside: held fixed
+            k.normal = d / dist;
+            k.leverI = p.radius[i] - 0.5 * overlap;
+            k.leverJ = p.radius[j] - 0.5 * overlap;
+            k.law = linearHertzContact(sim.interactions()(p.material[i], p.material[j]), radiusEff, massEff, overlap,
+                                       rolling, rollingInertiaEff(p.mass[i], p.radius[i], p.mass[j], p.radius[j]));
+            k.fixedParticle = local[j] < 0;
+            contacts.push_back(k);
+        });
         for (const Wall& w : sim.walls()) {
             found.clear();
             w.findContacts(p.position[i], p.radius[i], sim.time(), found);

@@ -67,26 +67,18 @@ void requireNoDeepOverlap(const std::vector<InsertedParticle>& inserted, const P
     }
     const CellBins bins = binIntoCells(position, 2.0 * *std::max_element(radius.begin(), radius.end()));
     for (std::size_t i = before; i < position.size(); ++i) {
-        const int cell = bins.cellOf[i];
-        const int cx = cell % bins.nx, cy = (cell / bins.nx) % bins.ny, cz = cell / (bins.nx * bins.ny);
-        for (int z = std::max(cz - 1, 0); z <= std::min(cz + 1, bins.nz - 1); ++z)
-            for (int y = std::max(cy - 1, 0); y <= std::min(cy + 1, bins.ny - 1); ++y)
-                for (int x = std::max(cx - 1, 0); x <= std::min(cx + 1, bins.nx - 1); ++x) {
-                    const int neighbour = (z * bins.ny + y) * bins.nx + x;
-                    for (int e = bins.cellStart[neighbour]; e < bins.cellStart[neighbour + 1]; ++e) {
-                        const std::size_t j = static_cast<std::size_t>(bins.particles[e]);
-                        if (j >= i) continue;  // itself, or a later new one (checked from there)
-                        const double overlap = radius[i] + radius[j] - (position[i] - position[j]).norm();
-                        if (!(overlap > 0.5 * std::min(radius[i], radius[j]))) continue;
-                        throw InputError(context + ": particle " + std::to_string(i - before) + " at " +
-                                         formatVec(position[i]) + " (radius " + std::to_string(radius[i]) +
-                                         ") overlaps " +
-                                         (j >= before ? "particle " + std::to_string(j - before) + " of the same insertion"
-                                                      : std::string("a particle already in the simulation")) +
-                                         " at " + formatVec(position[j]) + " by " + std::to_string(overlap) +
-                                         " m; expected particles at most half the smaller radius into each other");
-                    }
-                }
+        forEachInNeighbouringCells(bins, static_cast<int>(i), [&](int neighbour) {
+            const std::size_t j = static_cast<std::size_t>(neighbour);
+            if (j >= i) return;  // itself, or a later new one (checked from there)
+            const double overlap = radius[i] + radius[j] - (position[i] - position[j]).norm();
+            if (!(overlap > 0.5 * std::min(radius[i], radius[j]))) return;
+            throw InputError(context + ": particle " + std::to_string(i - before) + " at " + formatVec(position[i]) +
+                             " (radius " + std::to_string(radius[i]) + ") overlaps " +
+                             (j >= before ? "particle " + std::to_string(j - before) + " of the same insertion"
+                                          : std::string("a particle already in the simulation")) +
+                             " at " + formatVec(position[j]) + " by " + std::to_string(overlap) +
+                             " m; expected particles at most half the smaller radius into each other");
+        });
     }
 }
 

@@ -33,17 +33,18 @@ void Wall::findContacts(const Vec3& centre, double radius, double time, const Ri
 
 namespace {
 
+// Corner k (0-7) of the box [lower, upper]: bit 0 picks x, bit 1 y, bit 2 z.
+Vec3 boxCorner(const Vec3& lower, const Vec3& upper, int k) {
+    return Vec3((k & 1) ? upper.x() : lower.x(), (k & 2) ? upper.y() : lower.y(), (k & 4) ? upper.z() : lower.z());
+}
+
 // Box of a reference-frame box after a rigid transform: enclose its eight corners.
 BoundingBox transformed(const BoundingBox& box, const RigidTransform& pose) {
     if (box.isUnbounded() || box.isEmpty()) {
         return box;
     }
     BoundingBox result;
-    for (int corner = 0; corner < 8; ++corner) {
-        const Vec3 p((corner & 1) ? box.upper.x() : box.lower.x(), (corner & 2) ? box.upper.y() : box.lower.y(),
-                     (corner & 4) ? box.upper.z() : box.lower.z());
-        result.expand(pose.apply(p));
-    }
+    for (int corner = 0; corner < 8; ++corner) result.expand(pose.apply(boxCorner(box.lower, box.upper, corner)));
     return result;
 }
 
@@ -54,11 +55,8 @@ double distanceFromAxis(const Vec3& point, const Vec3& axisPoint, const Vec3& un
 
 double farthestCornerFromAxis(const Vec3& lower, const Vec3& upper, const Vec3& axisPoint, const Vec3& unitAxis) {
     double farthest = 0.0;
-    for (int corner = 0; corner < 8; ++corner) {
-        const Vec3 p((corner & 1) ? upper.x() : lower.x(), (corner & 2) ? upper.y() : lower.y(),
-                     (corner & 4) ? upper.z() : lower.z());
-        farthest = std::max(farthest, distanceFromAxis(p, axisPoint, unitAxis));
-    }
+    for (int corner = 0; corner < 8; ++corner)
+        farthest = std::max(farthest, distanceFromAxis(boxCorner(lower, upper, corner), axisPoint, unitAxis));
     return farthest;
 }
 
