@@ -3,14 +3,11 @@
 #include "demLib/contact_law_batch.hpp"
 
 #include "demLib/parallel.hpp"
+#include "demLib/spin_barrier.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
-
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 namespace dem {
 
@@ -19,14 +16,6 @@ namespace {
 // Cost of a pair in contact in units of a listed pair's touching test (the
 // split of the rows between threads; see compute()).
 constexpr long touchingPairCost = 3;
-
-int threadIndex() {
-#ifdef _OPENMP
-    return omp_get_thread_num();
-#else
-    return 0;
-#endif
-}
 
 // Where one thread's pair loop adds forces and torques: straight into the
 // particle arrays for the particles of its own rows [begin, end), which no other
@@ -143,6 +132,7 @@ public:
         }
         const long listVersion = pairs.version();
 
+        SpinBarrier teamBarrier;
 #pragma omp parallel num_threads(threads)
         {
             const int t = threadIndex();
@@ -169,7 +159,7 @@ public:
             newWall[t] = std::move(wallRecords);
             if (threads > 1) {
                 bufferedRanges_[t] = {sink.lowestBuffered, sink.highestBuffered + 1};
-#pragma omp barrier
+                teamBarrier.arriveAndWait(teamSize());
                 // The other threads' contributions to this thread's rows, in thread order.
                 for (int u = 0; u < threads; ++u) {
                     if (u == t) continue;
@@ -184,6 +174,9 @@ public:
                         otherTorque[i].setZero();
                     }
                 }
+                // Meet here rather than at the region's end, where GOMP puts an
+                // early thread to sleep (SpinBarrier).
+                teamBarrier.arriveAndWait(teamSize());
             }
         }
 

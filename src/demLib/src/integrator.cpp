@@ -1,6 +1,7 @@
 #include "demLib/integrator.hpp"
 
 #include "demLib/parallel.hpp"
+#include "demLib/spin_barrier.hpp"
 
 #include <algorithm>
 
@@ -41,25 +42,31 @@ DriftReport advance(ParticleStore& p, double dt, std::size_t count, const DriftE
     const bool external = cp.externalForce.allocated();
     bool moved = false;
     bool left = false;
-#pragma omp parallel for schedule(static) reduction(|| : moved, left) \
-    num_threads(threadsFor(n, lightLoopParticlesPerThread))
-    for (std::size_t i = 0; i < n; ++i) {
-        const InverseMass inv(p.mass[i], p.radius[i]);
-        const Vec3 dv = (half * inv.mass) * p.force[i];
-        const Vec3 dw = (half * inv.inertia) * p.torque[i];
-        for (int k = 0; k < kicks; ++k) {
-            p.velocity[i] += dv;
-            p.omega[i] += dw;
+    SpinBarrier teamBarrier;
+#pragma omp parallel num_threads(threadsFor(n, lightLoopParticlesPerThread))
+    {
+#pragma omp for schedule(static) reduction(|| : moved, left) nowait
+        for (std::size_t i = 0; i < n; ++i) {
+            const InverseMass inv(p.mass[i], p.radius[i]);
+            const Vec3 dv = (half * inv.mass) * p.force[i];
+            const Vec3 dw = (half * inv.inertia) * p.torque[i];
+            for (int k = 0; k < kicks; ++k) {
+                p.velocity[i] += dv;
+                p.omega[i] += dw;
+            }
+            if constexpr (drift) p.position[i] += dt * p.velocity[i];
+            if constexpr (watch) {
+                moved = moved || (p.position[i] - from[i]).squaredNorm() > limit2;
+                if (domain) left = left || domain->loses(p.position[i]);
+            }
+            if constexpr (reset) {
+                p.force[i] = bodyForce(cp, i, g, external);
+                p.torque[i].setZero();
+            }
         }
-        if constexpr (drift) p.position[i] += dt * p.velocity[i];
-        if constexpr (watch) {
-            moved = moved || (p.position[i] - from[i]).squaredNorm() > limit2;
-            if (domain) left = left || domain->loses(p.position[i]);
-        }
-        if constexpr (reset) {
-            p.force[i] = bodyForce(cp, i, g, external);
-            p.torque[i].setZero();
-        }
+        // Meet here rather than at the region's end, where GOMP puts an early
+        // thread to sleep (SpinBarrier).
+        teamBarrier.arriveAndWait(teamSize());
     }
     return {moved, left};
 }

@@ -1,31 +1,10 @@
 #include "demLib/thread_group.hpp"
 
 #include <algorithm>
-#include <thread>
 
 #include "demLib/error.hpp"
 
-#if defined(__x86_64__) || defined(__i386__)
-#include <immintrin.h>
-#endif
-
 namespace dem {
-
-namespace {
-
-void cpuRelax() {
-#if defined(__x86_64__) || defined(__i386__)
-    _mm_pause();
-#endif
-}
-
-// Spins before yielding: the ranks of a balanced step arrive within
-// microseconds of each other, and a sleeping thread's wake-up costs tens of
-// microseconds on a virtual machine (a step of 25 000 particles is ~2.5 ms).
-// Yielding after that keeps more ranks than cores progressing.
-constexpr int spinsBeforeYield = 20000;
-
-}  // namespace
 
 ThreadGroup::ThreadGroup(int ranks) : size_(ranks), calls_(static_cast<std::size_t>(std::max(ranks, 0))) {
     if (ranks < 1) throw InputError("demLib thread group: " + std::to_string(ranks) + " ranks; expected at least 1");
@@ -37,21 +16,9 @@ ThreadGroup::ThreadGroup(int ranks) : size_(ranks), calls_(static_cast<std::size
 
 int ThreadGroup::arriveAndWait(int rank) {
     const int phase = static_cast<int>(calls_[static_cast<std::size_t>(rank)].entered++ & 1U);
-    const std::uint64_t generation = generation_.load(std::memory_order_acquire);
-    if (arrived_.fetch_add(1, std::memory_order_acq_rel) + 1 == size_) {
-        arrived_.store(0, std::memory_order_relaxed);
-        generation_.store(generation + 1, std::memory_order_release);
-        return phase;
-    }
-    for (long spins = 0; generation_.load(std::memory_order_acquire) == generation; ++spins) {
-        if (abandoned_.load(std::memory_order_acquire))
-            throw RuntimeError("demLib thread group: rank " + std::to_string(rank) +
-                               " stopped waiting: another rank of the group failed");
-        if (spins < spinsBeforeYield)
-            cpuRelax();
-        else
-            std::this_thread::yield();
-    }
+    if (!barrier_.arriveAndWait(size_, &abandoned_))
+        throw RuntimeError("demLib thread group: rank " + std::to_string(rank) +
+                           " stopped waiting: another rank of the group failed");
     return phase;
 }
 

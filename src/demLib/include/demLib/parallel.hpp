@@ -28,4 +28,22 @@ inline int threadsFor(std::size_t n, std::size_t particlesPerThread) {
 #endif
 }
 
+// This thread's index in its OpenMP team, and the team's size (0 and 1 outside
+// a parallel region or without OpenMP).
+inline int threadIndex() {
+#ifdef _OPENMP
+    return omp_get_thread_num();
+#else
+    return 0;
+#endif
+}
+
+inline int teamSize() {
+#ifdef _OPENMP
+    return omp_get_num_threads();
+#else
+    return 1;
+#endif
+}
+
 }  // namespace dem

@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include "demLib/spin_barrier.hpp"
+
 namespace dem {
 
 enum class ReduceOp { sum, min, max, logicalOr };
@@ -50,8 +52,7 @@ private:
     int arriveAndWait(int rank);
 
     int size_;
-    std::atomic<int> arrived_{0};
-    std::atomic<std::uint64_t> generation_{0};
+    SpinBarrier barrier_;
     std::atomic<bool> abandoned_{false};
     struct alignas(64) Calls {
         std::uint64_t entered = 0;  // collectives this rank entered (their parity is the phase)
