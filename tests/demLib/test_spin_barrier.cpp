@@ -37,8 +37,8 @@ int roundsSeenOutOfStep(int threads, int rounds, long spinsBeforeYield) {
 }
 
 TEST(SpinBarrier, NobodyPassesBeforeAllHaveArrived) {
-    EXPECT_EQ(roundsSeenOutOfStep(2, 20000, dem::SpinBarrier::defaultSpinsBeforeYield), 0);
-    EXPECT_EQ(roundsSeenOutOfStep(3, 5000, dem::SpinBarrier::defaultSpinsBeforeYield), 0);
+    EXPECT_EQ(roundsSeenOutOfStep(2, 5000, dem::SpinBarrier::defaultSpinsBeforeYield), 0);
+    EXPECT_EQ(roundsSeenOutOfStep(3, 2000, dem::SpinBarrier::defaultSpinsBeforeYield), 0);
 }
 
 TEST(SpinBarrier, MoreThreadsThanCoresGetThroughByYielding) {
