@@ -7,10 +7,6 @@
 #include <cmath>
 #include <limits>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
 namespace dem {
 
 
@@ -149,11 +145,7 @@ void ParticleParticleNeighborList::buildFrom(const ParticleStore& particles,
     int* touchingCount = touchingOffsets_.data() + 1;
 #pragma omp parallel num_threads(threads)
     {
-#ifdef _OPENMP
-        const int t = omp_get_thread_num();
-#else
-        const int t = 0;
-#endif
+        const int t = threadIndex();
         const int begin = static_cast<int>(static_cast<long>(rows) * t / threads);
         const int end = static_cast<int>(static_cast<long>(rows) * (t + 1) / threads);
         BuildBlock& out = blocks_[t];
