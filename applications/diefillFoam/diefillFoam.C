@@ -36,8 +36,11 @@ Description
 #include "zeroGradientFvPatchFields.H"
 
 #include "demCoupling.H"
+#include "parallelLaunch.H"
 #include "progressReport.H"
 #include "stopSignal.H"
+
+#include <iostream>
 
 // * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * //
 
@@ -49,6 +52,16 @@ int main(int argc, char *argv[])
         " coupled to the DEM engine demLib by unresolved drag"
         " (constant/couplingProperties, constant/demProperties)."
     );
+
+    // -parallel on one process: OpenFOAM would abort with a stack trace.
+    {
+        const std::string problem = diefill::parallelLaunchProblem(argc, argv);
+        if (!problem.empty())
+        {
+            std::cerr << "\n--> diefillFoam: " << problem << "\n" << std::endl;
+            return 1;
+        }
+    }
 
     // No -postProcess and no -dry-run: both would start the DEM (and write
     // its output over an earlier run's) before they could do anything.
