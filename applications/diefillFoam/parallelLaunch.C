@@ -21,14 +21,21 @@ std::string Foam::diefill::parallelLaunchProblem(int argc, char* argv[])
         return {};
     }
 
-    // The number of processes the launcher started, where it tells.
-    const char* const sizeVariables[] = {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "SLURM_NTASKS"};
+    // The number of processes, where the launcher sets it in each process.
+    // (Not SLURM_NTASKS: a batch job's whole environment holds it, so it
+    // would count a launch of another MPI with 1 when the job has one task.)
+    const char* const sizeVariables[] =
+        {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "MV2_COMM_WORLD_SIZE"};
     const char* sizeText = nullptr;
     for (const char* name : sizeVariables)
     {
         if ((sizeText = std::getenv(name)) != nullptr) break;
     }
-    const bool launched = sizeText != nullptr || std::getenv("PMIX_RANK") != nullptr;
+    // Launchers that say only that they started this process: left to
+    // OpenFOAM's own check.
+    const bool launched = sizeText != nullptr
+        || std::getenv("PMIX_RANK") != nullptr
+        || std::getenv("SLURM_PROCID") != nullptr;
     if (launched && (sizeText == nullptr || std::atoi(sizeText) != 1))
     {
         return {};
