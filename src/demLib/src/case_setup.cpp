@@ -424,6 +424,12 @@ CaseSetup readCaseSetup(const Dictionary& root, const std::string& caseDir) {
         coeff.rollingViscousDamping = p.getOrDefault<double>("rollingViscousDamping", 0.0);
         if (s.forces.rolling != RollingModel::None && !p.has("rollingFriction"))
             invalid(p, "rollingFriction", "missing; the rolling model '" + rolling + "' needs it");
+        // Only EPSD has a viscous rolling term: given with another model the
+        // damping the user asked for would be silently absent.
+        if (p.has("rollingViscousDamping") && s.forces.rolling != RollingModel::EPSD)
+            invalid(p, "rollingViscousDamping",
+                    "is used by the rolling model 'epsd' only; the rolling model '" + rolling +
+                        "' has no viscous rolling damping: expected the keyword removed, or 'rolling epsd'");
         c.interactions.set(c.materials, a, b, coeff);
     }
     try {
