@@ -215,11 +215,23 @@ std::string CaseRunner::outputDirectory() const {
     return (fs::path(setup_.caseDir) / setup_.output.directory).string();
 }
 
-std::string latestRestartFile(const CaseSetup& setup) {
-    const fs::path dir = fs::path(setup.caseDir) / setup.output.directory / "restart";
-    std::ifstream in(dir / "latest");
+namespace {
+fs::path restartDirectory(const CaseSetup& setup) {
+    return fs::path(setup.caseDir) / setup.output.directory / "restart";
+}
+
+// The file name that the folder's `latest` names, or empty when there is no `latest`.
+std::string nameInLatest(const fs::path& restartDir) {
+    std::ifstream in(restartDir / "latest");
     std::string name;
-    if (!(in >> name)) return {};
+    return (in >> name) ? name : std::string();
+}
+}  // namespace
+
+std::string latestRestartFile(const CaseSetup& setup) {
+    const fs::path dir = restartDirectory(setup);
+    const std::string name = nameInLatest(dir);
+    if (name.empty()) return {};
     const fs::path file = dir / name;
     return fs::exists(file) ? file.string() : std::string();
 }
@@ -227,17 +239,16 @@ std::string latestRestartFile(const CaseSetup& setup) {
 std::string restartFileFor(const CaseSetup& setup, const std::string& arg, const std::string& tool) {
     const std::string who = tool.empty() ? std::string() : tool + ": ";
     if (arg == "latest") {
-        const std::string file = latestRestartFile(setup);
-        const fs::path dir = fs::path(setup.caseDir) / setup.output.directory / "restart";
-        std::string named;
-        if (file.empty() && (std::ifstream(dir / "latest") >> named))
+        const fs::path dir = restartDirectory(setup);
+        const std::string named = nameInLatest(dir);
+        if (named.empty())
+            throw InputError(who + "-restart latest: no restart file found in '" + dir.string() +
+                             "' (run the case first, or give -restart FILE)");
+        if (!fs::exists(dir / named))
             throw InputError(who + "-restart latest: '" + (dir / "latest").string() + "' names '" + named +
                              "', which is not there; expected a restart file of that folder (give it as "
                              "-restart FILE)");
-        if (file.empty())
-            throw InputError(who + "-restart latest: no restart file found in '" + dir.string() +
-                             "' (run the case first, or give -restart FILE)");
-        return file;
+        return (dir / named).string();
     }
     if (fs::exists(arg)) return arg;
     std::string message = who + "-restart '" + arg + "': no such file";
