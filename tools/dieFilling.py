@@ -9,12 +9,16 @@ postProcessing/:
   profile.csv / profile.png  bed surface in the plane of shoe motion (|y| < R/4) after
                              the opening, with the two fitted lines:
                              - central angle: fit over x in [-R/2, R/2] (the paper's 'central
-                               region', 33.8 deg measured, 32.9 deg simulated);
+                               region', 33.8 deg measured, 32.9 deg simulated), and
+                               with its sign (centralAngleAlongMotion: positive where the
+                               surface falls in the direction of the shoe's motion, as in
+                               the experiment); massFractionFirstHalf: the bed's share in
+                               the die's first half (x < 0);
                              - right-border angle: the bed's right edge (outermost particle
                                per height band, |y| < R/4) fitted against height between 20 %
                                and 80 % of the bed's height there; 90 deg = vertical
                                (paper: about 90 deg);
-  fillRatio.png              mass in the die / mass poured, vs time;
+  fillRatio.png, .csv        mass in the die / mass poured, vs time;
   sideView_filled.png, sideView_final.png   the bed from the side (like the paper's Fig. 5b);
   air.png                    (runs with air) the pressure on the aeration plate while the shoe's
                              bed is conditioned; the air leaving the die vs the powder entering;
@@ -53,6 +57,56 @@ def profile_plot(path, x, h, fits, title):
     ax.legend(fontsize=8)
     ax.set_title(title, fontsize=9)
     plots.save(fig, path, dpi=120)
+
+
+def slope_along_motion(slope):
+    """The central fit's angle with its sign: positive where the surface falls in the direction
+    of the shoe's motion (+x; the experiment's 33.8 deg, most powder in the die's first half),
+    negative where it rises."""
+    return float(np.degrees(np.arctan(-slope)))
+
+
+def half_masses(position, mass, radius):
+    """Mass of the bed on the die base (within the die's radius) in the die's first half along
+    the shoe's motion (x < 0) and in all: the paper's 'most of the material is deposited in the
+    first half of the cylinder'."""
+    on_base = np.hypot(position[:, 0], position[:, 1]) <= radius
+    total = float(np.sum(mass[on_base]))
+    first = float(np.sum(mass[on_base & (position[:, 0] < 0)]))
+    return first, total
+
+
+def value_at(t, values, when):
+    """The column's value on the summary line nearest to time `when` (None if it has none)."""
+    if values is None or len(t) == 0:
+        return None
+    return float(values[int(np.argmin(np.abs(np.asarray(t) - when)))])
+
+
+def liquid_results(s, shoe_pass, opening):
+    """The liquid coordination number (bridges per particle, paper: z = 8 at w = 0.05) when the
+    shoe starts to move (the conditioned bed at rest) and before the opening (the bed in the die)."""
+    if "liquidCoordinationNumber" not in s:
+        return {}
+    z = np.asarray(s["liquidCoordinationNumber"])
+    res = {}
+    if shoe_pass:
+        res["liquidCoordinationPassStart"] = {
+            "value": round(value_at(s["time"], z, shoe_pass[0]), 3), "unit": "-",
+            "description": "liquid bridges per particle at t = %g s, the shoe's start (paper: z = 8)" % shoe_pass[0]}
+    if opening is not None and opening <= s["time"][-1]:
+        res["liquidCoordinationFilled"] = {
+            "value": round(value_at(s["time"], z, opening), 3), "unit": "-",
+            "description": "liquid bridges per particle at t = %g s, before the opening" % opening}
+    return res
+
+
+def write_fill_ratio_csv(path, t, fill):
+    """fillRatio.csv: time and fill ratio of every summary line (the validation ladder keeps it)."""
+    with output.open_replacing(path) as f:
+        f.write("time_s,fillRatio\n")
+        for ti, fi in zip(t, fill):
+            f.write(f"{ti:.6g},{fi:.6g}\n")
 
 
 def first_time_reaching(t, values, level):
@@ -242,6 +296,7 @@ def report_before_opening(case, out, props, s, frames, poured, fill, opening, en
                 "fill ratio [-]", title="die fill ratio (run in progress, t = %.3g s of %g s)" % (t[-1], end_time),
                 vlines=[(opening, "die opening starts")] if opening <= t[-1] * 1.5 else ())
     plots.side_view(os.path.join(out, "sideView_latest.png"), latest, title=f"latest fields, t = {latest.time:.2f} s")
+    write_fill_ratio_csv(os.path.join(out, "fillRatio.csv"), t, fill)
     during = (t >= shoe_pass[0]) & (t <= shoe_pass[1]) if shoe_pass else np.zeros(len(t), bool)
     t50 = first_time_reaching(t, fill, 0.5)
     t90 = first_time_reaching(t, fill, 0.9)
@@ -256,6 +311,7 @@ def report_before_opening(case, out, props, s, frames, poured, fill, opening, en
     }
     res.update(common_results(t50, t90, float(np.mean(fill[during])) if during.any() else None, shoe_pass,
                               with_air, wet, "the part simulated so far"))
+    res.update(liquid_results(s, shoe_pass, opening))
     if with_air:
         res.update(case_air_results(case, props, min(opening, float(t[-1])), out, s)[0])
     res.update(wall_load_results(s, props, float(t[-1]), opening, poured - float(s["lostMass"][-1]),
@@ -352,6 +408,9 @@ def main():
                  + (f", right border {right['angle']:.1f} deg" if right else ""))
     plots.curve(os.path.join(out, "fillRatio.png"), t, [fill], ["mass in die / mass poured"], "time [s]",
                 "fill ratio [-]", title="die fill ratio", vlines=[(opening, "die opening starts")])
+    write_fill_ratio_csv(os.path.join(out, "fillRatio.csv"), t, fill)
+    first_half, on_base = half_masses(final.position, np.asarray(final.mass, float), radius)
+    along = slope_along_motion(centre["slope"])
     plots.side_view(os.path.join(out, "sideView_filled.png"), filled, title=f"filled die, t = {filled.time:.2f} s")
     plots.side_view(os.path.join(out, "sideView_final.png"), final, title=f"after opening, t = {final.time:.2f} s")
 
@@ -359,6 +418,17 @@ def main():
         "centralAngle": {"value": round(centre["angle"], 2), "unit": "deg",
                          "description": f"fit over x in [{-radius / 2 * 1e3:.1f}, {radius / 2 * 1e3:.1f}] mm "
                                         "(paper: 33.8 measured, 32.9 simulated)"},
+        "centralAngleAlongMotion": {"value": round(along, 2), "unit": "deg",
+                                    "description": "the central angle with its sign: positive where the surface "
+                                                   "falls in the direction of the shoe's motion (the experiment's), "
+                                                   "negative where it rises"},
+        "centralSlopeFalls": {"value": bool(along > 0), "unit": "-",
+                              "description": "the central surface falls in the direction of the shoe's motion "
+                                             "(as in the experiment)"},
+        "massFractionFirstHalf": {"value": round(first_half / on_base, 4) if on_base > 0 else None, "unit": "-",
+                                  "description": "of the bed on the die base after the opening, the share in the "
+                                                 "die's first half along the shoe's motion (x < 0; the paper: 'most "
+                                                 "of the material' there)"},
         "centralFitRms": {"value": round(centre["rms"] * 1e3, 3), "unit": "mm",
                           "description": "rms distance of the central profile points from the fitted line: a "
                                          "large value (compared with a grain, %.2f mm) means the surface there is "
@@ -384,6 +454,7 @@ def main():
         "openingStart": {"value": opening, "unit": "s"},
     }
     res.update(common_results(t50, t90, mean_fill_pass, shoe_pass, with_air, wet, "lower: the die fills later"))
+    res.update(liquid_results(s, shoe_pass, opening))
     if with_air:
         air, density = case_air_results(case, props, opening, out, s)
         res.update(air)
@@ -402,9 +473,11 @@ def main():
         print("dieFilling.py: the run is not finished (t = %g s of %g s): the figures below are those "
               "of that time, not the final ones" % (t[-1], end_time))
     results.write(case, res)
-    print("dieFilling (%s, %s): central angle %.1f deg (fit rms %.1f mm), right border %s deg, fill ratio %.3f, "
+    print("dieFilling (%s, %s): central angle %.1f deg (fit rms %.1f mm; the surface %s in the shoe's direction), "
+          "right border %s deg, fill ratio %.3f, "
           "lost at opening %.1f %%, die 50 %% / 90 %% full at t = %s / %s s"
           % ("wet" if wet else "dry", "air" if with_air else "vacuum", centre["angle"], centre["rms"] * 1e3,
+             "falls" if along > 0 else "rises",
              f"{right['angle']:.1f}" if right else "n/a", mass_die_filled / poured,
              100 * lost_at_opening / max(mass_die_filled, 1e-30),
              f"{t50:.3f}" if t50 is not None else "n/a", f"{t90:.3f}" if t90 is not None else "n/a"))

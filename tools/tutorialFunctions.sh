@@ -3,8 +3,9 @@
 #   tutorial_parse_args "$@"    sets QUICK (0/1), ROLLING (cdt|epsd2|epsd|none or empty = as in the file),
 #                               THREADS (default 1: on a shared 2-core machine one thread is several
 #                               times faster than two); prints the usage from the caller's header on -help.
-#                               A case's own flags: the caller's tutorial_case_option FLAG returns 0
-#                               when it took FLAG.  A missing or bad value (an option given as the
+#                               A case's own flags: the caller's tutorial_case_option FLAG [WORDS...]
+#                               returns 0 when it took FLAG (and sets TUTORIAL_CASE_VALUES to the
+#                               number of words after it that it took as FLAG's value).  A missing or bad value (an option given as the
 #                               value: -rolling -dry) stops it with one line, exit 2, nothing written
 #   tutorial_prepare [EXTRA]    constant/demProperties from constant/demProperties.orig (saved on the
 #                               first run) with the '// @quick ...' lines swapped in (-quick) and
@@ -79,7 +80,11 @@ tutorial_parse_args() {
                 esac ;;
             -h|-help|--help) tutorial_usage; exit 0 ;;
             *)
-                if declare -F tutorial_case_option > /dev/null && tutorial_case_option "$1"; then :; else
+                # A case option with a value sets TUTORIAL_CASE_VALUES=1 (the words it took after the flag).
+                TUTORIAL_CASE_VALUES=0
+                if declare -F tutorial_case_option > /dev/null && tutorial_case_option "$@"; then
+                    shift "$TUTORIAL_CASE_VALUES"
+                else
                     echo "$(basename "$0"): unknown option '$1'" >&2; tutorial_usage >&2; exit 2
                 fi ;;
         esac

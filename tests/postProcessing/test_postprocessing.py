@@ -610,6 +610,137 @@ def capillary_scaling_csv_is_checked():
           one_line_error(r, "plotCapillaryScaling.py", "scaling_short.csv", "line 2"), r.stderr.strip()[-300:])
 
 
+DIE_PROPS = """simulation { timeStep 1e-5; endTime 2.0; gravity (0 0 -9.81); }
+cohesion { model capillary; waterContent 0.05; }
+materials { sand { youngsModulus 5e6; poissonRatio 0.3; density 2650; } }
+walls
+{
+    dieWall { type cylinder; material steel; side inside; axisPoint (0 0 0); axis (0 0 1); radius 0.05;
+              range (-0.1 0); motion { open { type translate; start 1.0; end 1.5; velocity (0 0 -0.2); } } }
+    shoe { type cylinder; material steel; side inside; axisPoint (-0.1 0 0); axis (0 0 1); radius 0.05;
+           range (0 0.1); motion { pass { type translate; start 0.1; end 0.5; velocity (0.5 0 0); } } }
+}
+"""
+
+
+def wedge_bed(angle_deg, falls_along_motion, r=1.5e-3, radius=0.05, base_z=-0.1, mid_height=0.03):
+    """Spheres in columns on the die base (a grid of pitch 2r inside the die's circle) whose top
+    sphere touches the plane surface h(x) = mid_height -+ tan(angle) x: falling in +x (the shoe's
+    direction) or rising."""
+    slope = np.tan(np.radians(angle_deg)) * (-1 if falls_along_motion else 1)
+    pts = []
+    for x in np.arange(-radius + r, radius, 2 * r):
+        for y in np.arange(-radius + r, radius, 2 * r):
+            if np.hypot(x, y) > radius - r:
+                continue
+            top = mid_height + slope * x
+            for z in np.arange(top - r, r - 1e-12, -2 * r):
+                pts.append((x, y, base_z + z))
+    return np.array(pts)
+
+
+@test
+def die_filling_slope_direction():
+    """dieFilling.py on a synthetic bed: the signed central angle, the slope's direction and the
+    share in the die's first half follow the bed's tilt, both ways; z read at the shoe's start and
+    before the opening."""
+    for falls in (True, False):
+        case = os.path.join(TMP, "dieFill_%s" % ("falls" if falls else "rises"))
+        bed = wedge_bed(30.0, falls)
+        radii = np.full(len(bed), 1.5e-3)
+        m = float(np.sum(2650 * 4 / 3 * np.pi * radii ** 3))
+        header = ("time,step,particles,kineticEnergy,coordinationNumber,wallContacts,lostCount,lostMass,"
+                  "liquidCoordinationNumber,mass_die,mass_base")
+        rows = [(t, k, len(bed), 0, 5, 0, 0, 0, z, md, m) for k, (t, z, md) in
+                enumerate([(0.0, 0, 0), (0.1, 7.5, 0), (0.5, 7.9, 0.6 * m), (1.0, 8.2, m), (1.5, 8.2, m), (2.0, 8.1, m)])]
+        write_case(case, DIE_PROPS, [(0.0, bed, radii), (1.0, bed, radii), (2.0, bed, radii)], rows, header)
+        r = run_tool("dieFilling.py", "-case", case)
+        res = json.load(open(os.path.join(case, "postProcessing", "results.json"))) if r.returncode == 0 else {}
+        value = lambda k: res.get(k, {}).get("value")  # noqa: E731
+        signed, first = value("centralAngleAlongMotion"), value("massFractionFirstHalf")
+        want = 30.0 if falls else -30.0
+        check("dieFilling.py, a 30 deg bed that %s along the shoe's motion: signed central angle %+.0f within 1.5 deg"
+              % ("falls" if falls else "rises", want), signed is not None and abs(signed - want) < 1.5,
+              f"(got {signed}) {r.stderr[-300:]}")
+        check("dieFilling.py: centralSlopeFalls is %s" % falls, value("centralSlopeFalls") is falls,
+              f"(got {value('centralSlopeFalls')})")
+        # The wedge's share at x < 0: 1/2 + (4 R tan a / 3 pi) / (2 h_mid) = 0.5 +- 0.204 for 30 deg.
+        expected = 0.5 + (1 if falls else -1) * (4 * 0.05 * np.tan(np.radians(30)) / (3 * np.pi)) / (2 * 0.03)
+        check("dieFilling.py: share of the bed in the first half %.3f within 0.03" % expected,
+              first is not None and abs(first - expected) < 0.03, f"(got {first})")
+        check("dieFilling.py: liquid coordination at the shoe's start (7.5) and before the opening (8.2)",
+              value("liquidCoordinationPassStart") == 7.5 and value("liquidCoordinationFilled") == 8.2,
+              f"(got {value('liquidCoordinationPassStart')}, {value('liquidCoordinationFilled')})")
+        fill = os.path.join(case, "postProcessing", "fillRatio.csv")
+        lines = open(fill).read().split() if os.path.exists(fill) else []
+        check("dieFilling.py writes fillRatio.csv (one line per summary line)",
+              len(lines) == 7 and lines[0] == "time_s,fillRatio" and lines[3] == "0.5,0.6", f"{lines[:4]}")
+
+
+LADDER = os.path.join(ROOT, "tutorials", "dieFilling", "validation", "ladder")
+
+
+def ladder_run(folder, factor, exponent, seed, angle, lost, wall):
+    record = {"name": "cg%g-k%g-s%d-air" % (factor, exponent, seed), "coarseGrain": factor,
+              "capillaryExponent": exponent, "seed": seed, "air": True, "timeStep": 6.25e-7 * factor,
+              "particles": 100, "wallTime": wall, "threads": 2, "build": "abcdef0", "finished": "2026-12-03 12:00 UTC",
+              "results": {"centralAngleAlongMotion": angle, "centralAngle": abs(angle), "centralSlopeFalls": angle > 0,
+                          "centralFitRms": 1.0, "rightBorderAngle": 85.0, "fractionLostAtOpening": lost,
+                          "massFractionFirstHalf": 0.6, "liquidCoordinationPassStart": 8.5, "fillTime50": 3.0},
+              "profile": [[x, 30.0 - 0.5 * x] for x in range(-50, 51, 5)], "fillRatio": [[0, 0], [5, 1]]}
+    with open(os.path.join(folder, record["name"] + ".json"), "w") as f:
+        json.dump(record, f)
+
+
+@test
+def ladder_report_statistics():
+    """validation/ladder report on made-up run files: ensembles grouped by everything but the
+    seed, mean and sample standard deviation, the table between the README's markers, -check
+    passes on what report wrote and fails once a run file changes; collect refuses an unfinished run."""
+    runs = os.path.join(TMP, "ladder", "runs")
+    out = os.path.join(TMP, "ladder")
+    os.makedirs(runs)
+    for seed, angle in ((1, 20.0), (2, 30.0), (3, 40.0)):
+        ladder_run(runs, 10, 1, seed, angle, 0.01 * seed, 3600.0 * seed)
+    ladder_run(runs, 10, 2.0142, 1, -5.0, 0.0, 3600.0)
+    readme = os.path.join(out, "README.md")
+    with open(readme, "w") as f:
+        f.write("intro\n<!-- ladder table: written by ./ladder report from runs/*.json; do not edit by hand -->\n"
+                "old\n<!-- end of the ladder table -->\nafter\n")
+    r = subprocess.run([sys.executable, LADDER, "report", "-runs", runs, "-out", out, "-readme", readme],
+                       capture_output=True, text=True)
+    ens = json.load(open(os.path.join(out, "ensemble.json"))) if r.returncode == 0 else []
+    k1 = [e for e in ens if e["capillaryExponent"] == 1]
+    ok = len(ens) == 2 and len(k1) == 1 and k1[0]["runs"] == 3
+    check("ladder report: two ensembles, three seeds in one", ok, r.stderr[-300:])
+    if ok:
+        a = k1[0]["centralAngleAlongMotion"]
+        check("ladder report: mean 30 and sample sd 10 of 20, 30, 40", a["mean"] == 30.0 and a["sd"] == 10.0, f"{a}")
+        check("ladder report: the wall time's mean (2 h) and the slope's count (3 of 3)",
+              k1[0]["wallTime"]["mean"] == 7200.0 and k1[0]["slopeFallsAlongMotion"] == 3)
+    text = open(readme).read()
+    check("ladder report: the table replaces what stood between the markers, the rest kept",
+          text.startswith("intro\n") and text.endswith("after\n") and "old" not in text
+          and "30.0 ± 10.0" in text and "| cg10-k1-s2-air |" in text, text[:200])
+    for png in ("profiles.png", "fillRatio.png"):
+        path = os.path.join(out, png)
+        check(f"ladder report writes {png}", os.path.exists(path) and open(path, "rb").read(4) == b"\x89PNG")
+    check_cmd = [sys.executable, LADDER, "report", "-check", "-runs", runs, "-out", out, "-readme", readme]
+    r = subprocess.run(check_cmd, capture_output=True, text=True)
+    check("ladder report -check passes on what report wrote", r.returncode == 0, r.stderr[-300:])
+    ladder_run(runs, 10, 1, 2, 31.0, 0.02, 7200.0)
+    r = subprocess.run(check_cmd, capture_output=True, text=True)
+    check("ladder report -check fails once a run file changed, naming the table",
+          r.returncode == 1 and "README.md's ladder table is not what runs/*.json give" in r.stderr, r.stderr[-300:])
+    unfinished = os.path.join(TMP, "ladder", "unfinished")
+    os.makedirs(os.path.join(unfinished, "case", "dem"))
+    with open(os.path.join(unfinished, "case", "dem", "summary.csv"), "w") as f:
+        f.write("time,step\n0.5,10\n")
+    r = subprocess.run([sys.executable, LADDER, "collect", unfinished], capture_output=True, text=True)
+    check("ladder collect refuses a run that has not finished", r.returncode == 1 and "has not finished" in r.stderr,
+          r.stderr[-300:])
+
+
 import shutil  # noqa: E402
 
 shutil.rmtree(TMP, ignore_errors=True)
