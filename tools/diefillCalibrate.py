@@ -1,0 +1,128 @@
+#!/usr/bin/env python3
+"""diefillCalibrate: calibrates contact parameters of a case against measured bulk results
+(the paper's section 4: the inclined plate, then the repose test with the plate's result
+kept fixed), running the simulations itself.
+
+    diefillCalibrate [DICT] [-workDir DIR] [-check] [-report] [-stopAfter N] [-help]
+
+DICT (default ./calibrationDict) is an OpenFOAM-style dictionary:
+
+    workDir        calibration;     // where the runs, the table and the results go (beside DICT)
+    runsInParallel 1;               // simulations at once, each in its own case copy
+    threadsPerRun  1;               // demRun threads per simulation (Allrun -threads)
+    onFailure      continue;        // continue | stop, when a run fails
+    seed           1;
+    stages                          // run in this order; a stage keeps the earlier ones' results fixed
+    {
+        plate
+        {
+            case       "$DIEFILL_DIR/tutorials/calibration/inclinedPlate";
+            setting    quick;                                  // quick | full
+            allrunOptions ( -rolling cdt );                    // optional, passed to Allrun
+            fixed      { interactions/sand-sand/friction 0.7; }   // optional
+            parameters { interactions/sand-steel/friction (0.3 0.9); }
+            targets    { angleAt50PercentSlid { value 29; sigma 1.5; } }   // keys of postProcessing/results.json
+            initialRuns 4;  minRuns 5;  maxRuns 16;  tolerance 1;  eiTolerance 0.01;   // optional
+        }
+    }
+
+Method: a Latin-hypercube first sample, then one Gaussian-process surrogate per target and
+expected improvement of chi2 = sum ((y - value)/sigma)^2; it stops when a run agrees with every
+target within tolerance x sigma and no point promises an improvement above eiTolerance, or at
+maxRuns.  Output per stage in WORKDIR/STAGE/: runs.csv (every finished run), result.json (chosen
+run, posterior mean, sd and 95 % interval per parameter), demPropertiesFragment, response.png,
+samples.png, convergence.png.  Run again after an interruption: finished runs are kept, a run
+that was stopped continues from its restart files.  docs/calibration.md has the details.
+
+Options:
+  -workDir DIR   the work folder (instead of the dictionary's workDir)
+  -check         read and check the dictionary and its cases; run nothing
+  -report        write the results and plots from the runs made so far; run nothing
+  -stopAfter N   stop once N runs have finished in this call (run again to continue)
+Exit status: 0 done (every stage converged), 1 bad input or a failed run with onFailure stop,
+3 a stage used up maxRuns without agreeing with its targets (the later stages are not run),
+4 stopped (-stopAfter or a signal) before the end."""
+import json
+import os
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from _common import argument_parser, positive_int  # noqa: E402
+from diefillcal import config, report, runner  # noqa: E402
+
+
+def main():
+    ap = argument_parser(__doc__)
+    ap.add_argument("dict", nargs="?", default="calibrationDict", help="the calibration dictionary")
+    ap.add_argument("-workDir", default=None)
+    ap.add_argument("-check", action="store_true")
+    ap.add_argument("-report", action="store_true")
+    ap.add_argument("-stopAfter", type=positive_int, default=None)
+    a = ap.parse_args()
+    if not os.environ.get("DIEFILL_DIR"):
+        os.environ["DIEFILL_DIR"] = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    try:
+        c = config.read(a.dict, a.workDir)
+    except config.InputError as e:
+        print(f"diefillCalibrate: error: {e}", file=sys.stderr)
+        return 1
+    if a.check:
+        for s in c.stages:
+            print(f"{s.name}: {s.case} ({s.setting}); parameters "
+                  + ", ".join(f"{p.keyword} {p.low:g}-{p.high:g}" for p in s.parameters) + "; targets "
+                  + ", ".join(f"{t.key} {t.value:g} +- {t.sigma:g}" for t in s.targets)
+                  + f"; {s.initial_runs} design runs, at most {s.max_runs}")
+        print(f"diefillCalibrate: {a.dict} is fine; work folder {c.work_dir}")
+        return 0
+    carried = {}
+    stop_after = a.stopAfter
+    for s in c.stages:
+        started = time.time()
+        r = runner.StageRunner(c, s, dict(carried))
+        if carried:
+            print(f"{s.name}: kept fixed from the earlier stage(s): "
+                  + ", ".join(f"{k} {v:.4g}" for k, v in carried.items()), flush=True)
+        try:
+            if a.report:
+                r.open()
+                outcome = "report"
+            else:
+                print(f"{s.name}: case {s.case} ({s.setting}), work folder {r.folder}", flush=True)
+                outcome = r.run(stop_after=stop_after)
+        except config.InputError as e:
+            print(f"diefillCalibrate: error: {e}", file=sys.stderr)
+            return 1
+        except runner.StopCalibration as e:
+            print(f"diefillCalibrate: stopped: {e}", file=sys.stderr)
+            return 1
+        if outcome == "stopped":
+            print(f"{s.name}: stopped with {len(r.table.rows)} runs finished; run the same command again to continue",
+                  flush=True)
+            return 4
+        if stop_after is not None:
+            stop_after -= r.finished_here
+        try:
+            result = report.summarise(r, outcome, time.time() - started)
+        except ValueError as e:
+            print(f"diefillCalibrate: error: {e}", file=sys.stderr)
+            return 1
+        print(f"{s.name}: {outcome} after {result['runs']} runs ({result['failedRuns']} failed, "
+              f"{result['simulationSeconds'] / 60:.1f} min of simulation); chosen run {result['chosenRun']}: "
+              + ", ".join(f"{t} {v:.4g}" for t, v in result["chosenTargets"].items()), flush=True)
+        for keyword, p in result["posterior"].items():
+            print(f"    {keyword} = {result['chosen'][keyword]:.4g}   (posterior {p['mean']:.4g} +- {p['std']:.2g}, "
+                  f"95 %: {p['q2.5']:.4g} - {p['q97.5']:.4g}; range {p['range'][0]:g}-{p['range'][1]:g})", flush=True)
+        print(f"    demProperties fragment: {os.path.join(r.folder, 'demPropertiesFragment')}; plots: "
+              f"{os.path.join(r.folder, '{response,samples,convergence}.png')}", flush=True)
+        if outcome == "budget" and not a.report:
+            print(f"diefillCalibrate: stage '{s.name}' used its {s.max_runs} runs (maxRuns) without a run within "
+                  f"{s.tolerance:g} sigma of every target and a settled surrogate; the later stages are not run. "
+                  f"Raise maxRuns (the runs made are kept) or widen the ranges", file=sys.stderr)
+            return 3
+        carried.update(result["chosen"])
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

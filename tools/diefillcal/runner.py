@@ -1,0 +1,358 @@
+"""Running a stage: case copies, the table of finished runs, restart, the loop that fills
+the free slots with the design's points and then with the surrogate's proposals."""
+import csv
+import json
+import math
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+from scipy import stats
+
+from . import casefile, method
+from .config import InputError
+
+TABLE = "runs.csv"
+RECORD = "stage.json"
+RUN_PARAMETERS = "calibrationRun.json"
+RUN_LOG = "log.calibrationRun"
+# Results of an earlier run in the tutorial folder are not copied into a run's case.
+_NOT_COPIED = {"dem", "postProcessing", "runRecord", "setting"}
+
+
+class StopCalibration(Exception):
+    """A run failed and onFailure is 'stop', or the user stopped the tool."""
+
+
+def _say(text):
+    print(text, flush=True)
+
+
+def _write_atomically(path, text):
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        f.write(text)
+        f.flush()
+        os.fsync(f.fileno())
+    os.replace(tmp, path)
+
+
+class RunTable:
+    """The finished runs of a stage, one row each, rewritten whole (atomically) after each."""
+
+    def __init__(self, path):
+        self.path = path
+        self.rows = []
+        if os.path.exists(path):
+            with open(path, newline="") as f:
+                self.rows = list(csv.DictReader(f))
+
+    def add(self, row):
+        self.rows.append({k: ("" if v is None else v) for k, v in row.items()})
+        columns = []
+        for r in self.rows:
+            columns += [k for k in r if k not in columns]
+        import io
+        buffer = io.StringIO()
+        w = csv.DictWriter(buffer, columns, restval="")
+        w.writeheader()
+        for r in self.rows:
+            w.writerow(r)
+        _write_atomically(self.path, buffer.getvalue())
+
+    def ids(self):
+        return {int(r["run"]) for r in self.rows}
+
+
+def _copy_case(source, dest):
+    def ignore(folder, names):
+        return [n for n in names if n in _NOT_COPIED or n.startswith("log.") or n == "demProperties.orig"]
+    shutil.copytree(source, dest, ignore=ignore, symlinks=True)
+    orig = os.path.join(source, "constant", "demProperties.orig")
+    if os.path.exists(orig):       # Allrun has run in the source: .orig is the input, not the generated file
+        shutil.copy2(orig, os.path.join(dest, "constant", "demProperties"))
+
+
+class StageRunner:
+    def __init__(self, calibration, stage, carried):
+        self.c = calibration
+        self.s = stage
+        self.carried = carried            # keyword -> value from earlier stages
+        self.folder = os.path.join(calibration.work_dir, stage.name)
+        self.table = None
+        self.running = {}                 # run id -> (process, start time, parameters, log file)
+        self.stopping = False
+        self.finished_here = 0
+        self.started = time.time()
+
+    # ---- the record of what the runs mean, checked on restart -------------------------------
+    def open(self):
+        os.makedirs(os.path.join(self.folder, "runs"), exist_ok=True)
+        record_path = os.path.join(self.folder, RECORD)
+        record = self.s.record(self.carried)
+        if os.path.exists(record_path):
+            old = json.load(open(record_path))
+            changed = [k for k in record if json.dumps(old.get(k), sort_keys=True) != json.dumps(record[k], sort_keys=True)]
+            if changed:
+                raise InputError(
+                    f"{self.c.path}: stage '{self.s.name}': {', '.join(changed)} changed since the runs in "
+                    f"{self.folder} were made (recorded in {record_path}: {', '.join(json.dumps(old.get(k)) for k in changed)}); "
+                    f"their results would not belong to this calibration. Undo the change, or give another workDir "
+                    f"(or -workDir) to start afresh" +
+                    (" (the earlier stage's result changed: its values are kept fixed here)" if "fixed" in changed else ""))
+        else:
+            _write_atomically(record_path, json.dumps(record, indent=1))
+        self.table = RunTable(os.path.join(self.folder, TABLE))
+
+    # ---- the points ---------------------------------------------------------------------------
+    def finished_ok(self):
+        rows = [r for r in self.table.rows if r["status"] == "ok"]
+        x = np.array([[self.s.parameters[k].to_unit(float(r[p.keyword])) for k, p in enumerate(self.s.parameters)]
+                      for r in rows]).reshape(-1, len(self.s.parameters))
+        y = np.array([[float(r[t.key]) for t in self.s.targets] for r in rows]).reshape(-1, len(self.s.targets))
+        return rows, x, y
+
+    def misfit(self, values):
+        return float(sum(((v - t.value) / t.sigma) ** 2 for v, t in zip(values, self.s.targets)))
+
+    def design(self):
+        return method.initial_design(self.s.initial_runs, len(self.s.parameters), self.c.seed)
+
+    def surrogate(self, x, y):
+        return method.Surrogate(x, y, [t.value for t in self.s.targets], [t.sigma for t in self.s.targets],
+                                seed=self.c.seed)
+
+    def _failed_points(self):
+        return np.array([[self.s.parameters[k].to_unit(float(r[p.keyword])) for k, p in enumerate(self.s.parameters)]
+                         for r in self.table.rows if r["status"] != "ok"]).reshape(-1, len(self.s.parameters))
+
+    def next_point(self, run_id):
+        """Unit-cube point of run `run_id`: the design's for the first runs, then the
+        surrogate's proposal with the running points believed."""
+        d = len(self.s.parameters)
+        if run_id <= self.s.initial_runs:
+            return self.design()[run_id - 1], "design"
+        _, x, y = self.finished_ok()
+        if len(x) < 2:
+            # too few good runs for a surrogate (failures): more space-filling points
+            return stats.qmc.Sobol(d=d, seed=self.c.seed + 1).random(64)[run_id % 64], "space-filling"
+        s = self.surrogate(x, y)
+        pending = np.array([r[2] for r in self.running.values()]).reshape(-1, d)
+        s = s.believe(pending)
+        best = min(self.misfit(v) for v in y)
+        done = np.vstack([x, pending, self._failed_points()]) if len(pending) else np.vstack([x, self._failed_points()])
+        points, _ = method.propose(s, done, best, 1, avoid=self._failed_points(), seed=self.c.seed + run_id)
+        return points[0], "expected improvement"
+
+    # ---- one run ----------------------------------------------------------------------------
+    def run_folder(self, run_id):
+        return os.path.join(self.folder, "runs", f"run{run_id:04d}")
+
+    def launch(self, run_id, unit_point, why):
+        folder = self.run_folder(run_id)
+        values = {p.keyword: float(p.from_unit(u)) for p, u in zip(self.s.parameters, unit_point)}
+        marker = os.path.join(folder, RUN_PARAMETERS)
+        if os.path.exists(marker):
+            _say(f"{self.s.name}: run {run_id} was stopped before it finished; continuing it in {folder}")
+        else:
+            if os.path.exists(folder):
+                shutil.rmtree(folder)         # a copy that was never started (stopped while copying)
+            _copy_case(self.s.case, folder)
+            props = os.path.join(folder, "constant", "demProperties")
+            casefile.set_values(props, {**self.carried, **self.s.fixed, **values})
+            _write_atomically(marker, json.dumps({"run": run_id, "unit": list(map(float, unit_point)),
+                                                  "values": values, "why": why}, indent=1))
+        command = ["./Allrun"] + (["-quick"] if self.s.setting == "quick" else []) + self.s.allrun_options \
+            + ["-threads", str(self.c.threads_per_run)]
+        log = open(os.path.join(folder, RUN_LOG), "a")
+        env = dict(os.environ, DIEFILL_DIR=os.environ.get("DIEFILL_DIR", ""))
+        process = subprocess.Popen(command, cwd=folder, stdout=log, stderr=subprocess.STDOUT, env=env,
+                                   start_new_session=True)   # its own group: a stop reaches demRun too
+        self.running[run_id] = (process, time.time(), np.asarray(unit_point, float), log)
+        shown = ", ".join(f"{p.name} {v:.4g}" for p, v in zip(self.s.parameters, values.values()))
+        _say(f"{self.s.name}: run {run_id} started ({why}): {shown}")
+
+    def resume_points(self):
+        """Runs with a case copy and parameters but no row in the table: stopped before they
+        finished; they go on with their own parameters."""
+        out = []
+        runs = os.path.join(self.folder, "runs")
+        done = self.table.ids()
+        for name in sorted(os.listdir(runs)):
+            marker = os.path.join(runs, name, RUN_PARAMETERS)
+            if name.startswith("run") and os.path.exists(marker):
+                m = json.load(open(marker))
+                if m["run"] not in done:
+                    out.append((m["run"], np.array(m["unit"]), m["why"]))
+        return out
+
+    def collect(self, run_id, process, start, unit_point, log):
+        log.close()
+        folder = self.run_folder(run_id)
+        log_path = os.path.join(folder, RUN_LOG)
+        seconds = time.time() - start
+        row = {"run": run_id}
+        for p, u in zip(self.s.parameters, unit_point):
+            row[p.keyword] = f"{p.from_unit(u):.10g}"
+        message = ""
+        results = {}
+        rc = process.returncode
+        if rc != 0:
+            tail = open(log_path, errors="replace").read().strip().splitlines()[-8:]
+            message = f"Allrun exited with status {rc}; log: {log_path}; last lines: " + " | ".join(tail)
+        else:
+            path = os.path.join(folder, "postProcessing", "results.json")
+            try:
+                results = json.load(open(path))
+            except (OSError, ValueError) as e:
+                message = f"no readable {path} ({e}); log: {log_path}"
+        scalars = {}
+        for k, v in results.items():
+            value = v.get("value") if isinstance(v, dict) else v
+            if isinstance(value, (int, float)) and not isinstance(value, bool):
+                scalars[k] = value
+        if not message:
+            for t in self.s.targets:
+                if t.key not in results:
+                    raise InputError(f"{self.c.path}: stages/{self.s.name}/targets/{t.key}: the case does not report "
+                                     f"'{t.key}' (run {run_id}'s {path} has: {', '.join(sorted(scalars))})")
+                if t.key not in scalars or not math.isfinite(scalars[t.key]):
+                    message = (f"results.json gives no number for '{t.key}' ({results[t.key]!r}): the test did not "
+                               f"reach it at these parameters; log: {log_path}")
+                    break
+        status = "failed" if message else "ok"
+        row["status"] = status
+        for t in self.s.targets:
+            row[t.key] = scalars.get(t.key)
+        row["misfit"] = f"{self.misfit([scalars[t.key] for t in self.s.targets]):.6g}" if status == "ok" else ""
+        row["seconds"] = f"{seconds:.1f}"
+        for k, v in scalars.items():
+            row.setdefault(k, v)
+        row["folder"] = os.path.relpath(folder, self.folder)
+        row["message"] = message
+        self.table.add(row)
+        return row
+
+    # ---- the loop ---------------------------------------------------------------------------
+    def converged(self):
+        """(converged, best row, largest expected improvement): a run agrees with every
+        target within tolerance x sigma, and no point promises an improvement of the misfit
+        above eiTolerance."""
+        rows, x, y = self.finished_ok()
+        if not rows:
+            return False, None, None
+        k = int(np.argmin([self.misfit(v) for v in y]))
+        agrees = all(abs(v - t.value) <= self.s.tolerance * t.sigma for v, t in zip(y[k], self.s.targets))
+        if len(rows) < 2 or len(self.table.rows) < self.s.min_runs:
+            return False, rows[k], None
+        s = self.surrogate(x, y)
+        _, ei = method.propose(s, np.vstack([x, self._failed_points()]), self.misfit(y[k]), 1,
+                               avoid=self._failed_points(), seed=self.c.seed)
+        return agrees and ei[0] < self.s.ei_tolerance, rows[k], ei[0]
+
+    def _stop_children(self, signum):
+        for process, *_ in self.running.values():
+            try:
+                os.killpg(process.pid, signal.SIGTERM)
+            except ProcessLookupError:
+                pass
+
+    def run(self, stop_after=None):
+        """Runs the stage until it converges or maxRuns are finished.  Returns 'converged',
+        'budget' or 'stopped' (stop_after runs finished in this call, or a signal)."""
+        self.open()
+        self.finished_here = 0
+        resume = self.resume_points()
+        previous = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+
+        def on_signal(signum, frame):
+            self.stopping = True
+            _say(f"{self.s.name}: stopping (signal {signum}): the runs in progress write their restart files; "
+                 f"run diefillCalibrate again to continue them")
+            self._stop_children(signum)
+        for s in previous:
+            signal.signal(s, on_signal)
+        outcome = None          # set once no more runs are to be started
+        checked_at = -1
+        try:
+            while True:
+                total = len(self.table.rows)
+                if outcome is None and total != checked_at and not resume:
+                    checked_at = total
+                    if self.converged()[0]:
+                        outcome = "converged"
+                if outcome is None and total >= self.s.max_runs:
+                    outcome = "budget"
+                if outcome is None and (self.stopping or (stop_after is not None and self.finished_here >= stop_after)):
+                    outcome = "stopped"
+                if outcome is None:
+                    while len(self.running) < self.c.runs_in_parallel and total + len(self.running) < self.s.max_runs:
+                        if resume:
+                            run_id, point, why = resume.pop(0)
+                        else:
+                            used = self.table.ids() | set(self.running)
+                            # the design's runs first, then the surrogate's
+                            missing = [i for i in range(1, self.s.initial_runs + 1) if i not in used]
+                            run_id = missing[0] if missing else max(used | {0}) + 1
+                            point, why = self.next_point(run_id)
+                        self.launch(run_id, point, why)
+                if not self.running:
+                    if outcome is None:
+                        continue
+                    return outcome
+                for run_id in self._wait():
+                    process, start, point, log = self.running.pop(run_id)
+                    if self.stopping and process.returncode != 0:
+                        log.close()
+                        continue                       # stopped by us: continued next time, not recorded
+                    row = self.collect(run_id, process, start, point, log)
+                    self.finished_here += 1
+                    self._progress(row)
+                    if row["status"] != "ok":
+                        _say(f"{self.s.name}: run {run_id} FAILED: {row['message']}")
+                        if self.c.on_failure == "stop":
+                            raise StopCalibration(f"stage '{self.s.name}': run {run_id} failed and onFailure is "
+                                                  f"'stop': {row['message']}")
+        except BaseException:
+            self._stop_children(signal.SIGTERM)
+            for process, *_ in self.running.values():
+                process.wait()
+            raise
+        finally:
+            for s, h in previous.items():
+                signal.signal(s, h)
+
+    def _wait(self):
+        while True:
+            finished = [k for k, (p, *_) in self.running.items() if p.poll() is not None]
+            if finished:
+                return finished
+            time.sleep(0.2)
+
+    def _progress(self, row):
+        rows, x, y = self.finished_ok()
+        n = len(self.table.rows)
+        best = min(rows, key=lambda r: float(r["misfit"])) if rows else None
+        values = ", ".join(f"{t.key} {float(row[t.key]):.4g}" for t in self.s.targets) if row["status"] == "ok" else "failed"
+        seconds = [float(r["seconds"]) for r in self.table.rows]
+        left = self.s.max_runs - n
+        eta = np.mean(seconds) * math.ceil(left / self.c.runs_in_parallel) if seconds else 0
+        text = f"{self.s.name}: run {row['run']} done, {n} of at most {self.s.max_runs} finished: {values}"
+        if row["status"] == "ok":
+            text += f" (misfit {float(row['misfit']):.3g})"
+        if best:
+            text += f"; best so far run {best['run']} (misfit {float(best['misfit']):.3g})"
+        text += f"; {float(row['seconds']):.0f} s; at most {_duration(eta)} left"
+        _say(text)
+
+
+def _duration(seconds):
+    if seconds < 120:
+        return f"{seconds:.0f} s"
+    if seconds < 7200:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"
