@@ -87,6 +87,7 @@ class StageRunner:
         self.running = {}                 # run id -> (process, start time, parameters, log file)
         self.stopping = False
         self.finished_here = 0
+        self._design = None
         self.started = time.time()
 
     # ---- the record of what the runs mean, checked on restart -------------------------------
@@ -120,7 +121,9 @@ class StageRunner:
         return float(sum(((v - t.value) / t.sigma) ** 2 for v, t in zip(values, self.s.targets)))
 
     def design(self):
-        return method.initial_design(self.s.initial_runs, len(self.s.parameters), self.c.seed)
+        if self._design is None:
+            self._design = method.initial_design(self.s.initial_runs, len(self.s.parameters), self.c.seed)
+        return self._design
 
     def surrogate(self, x, y):
         return method.Surrogate(x, y, [t.value for t in self.s.targets], [t.sigma for t in self.s.targets],
@@ -299,6 +302,8 @@ class StageRunner:
                             missing = [i for i in range(1, self.s.initial_runs + 1) if i not in used]
                             run_id = missing[0] if missing else max(used | {0}) + 1
                             point, why = self.next_point(run_id)
+                        if self.stopping:           # a signal came while the point was chosen
+                            break
                         self.launch(run_id, point, why)
                 if not self.running:
                     if outcome is None:
