@@ -312,7 +312,7 @@ def check_words(root, pages):
                 for m in WORDS.finditer(line):
                     print(f"FAIL words {os.path.relpath(page, root)}:{number}: '{m.group(0)}'")
                     failed += 1
-    print(f"checkDocs words: {len(pages)} checked, {failed} failed")
+    print(f"checkDocs words: {len(pages)} pages checked, {failed} failed (mentions)")
     return failed == 0
 
 
