@@ -22,7 +22,8 @@ exclude_patterns = ["build", "install", "platforms", "ThirdParty", "run", ".cach
 
 # Headings get anchors so that links like user-guide.md#running-in-parallel resolve.
 myst_heading_anchors = 3
-myst_enable_extensions = ["dollarmath", "colon_fence"]
+# No dollarmath: the pages write formulas in plain text, and a $ in prose stays a $.
+myst_enable_extensions = ["colon_fence"]
 
 html_theme = "alabaster"
 html_title = "diefill manual"
