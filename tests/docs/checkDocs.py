@@ -12,6 +12,10 @@
     checkDocs.py words [-root DIR] [FILE.md ...]
         no page speaks of sessions or of the development machines (history is dated by
         build and date, docs/performance.md).
+    checkDocs.py layout [-root DIR]
+        the README's status table has one line per figure, each naming where it is measured
+        (a link or a path), no cell a paragraph; docs/performance.md shows the figures against
+        LIGGGHTS with the machine, date and build in its first screen.
 
 Prints one line per failure and 'checkDocs <what>: N checked, M failed'; exits 1 on a failure.
 """
@@ -316,6 +320,62 @@ def check_words(root, pages):
     return failed == 0
 
 
+# ----------------------------------------------------------------- the layout
+FIRST_SCREEN = 25        # lines of a page a reader sees first
+LONGEST_CELL = 320       # characters: a table cell, not a paragraph
+
+
+def check_layout(root):
+    """The README's status table: one line per figure, each naming where it is measured, no
+    paragraphs; docs/performance.md: the figures against LIGGGHTS, with the machines they
+    were measured on, within the first screen."""
+    failed = 0
+    readme = os.path.join(root, "README.md")
+    with open(readme, encoding="utf-8") as f:
+        lines = f.read().split("\n")
+    try:
+        start = next(i for i, l in enumerate(lines) if re.match(r"^## Where it stands", l))
+    except StopIteration:
+        print("FAIL layout README.md: no section '## Where it stands'")
+        return False
+    rows = []
+    for number in range(start + 1, len(lines)):
+        line = lines[number]
+        if line.startswith("## "):
+            break
+        if line.startswith("|") and not re.match(r"^\|[-| :]+\|$", line):
+            rows.append((number + 1, [c.strip() for c in line.strip().strip("|").split("|")]))
+    if len(rows) < 2:
+        print("FAIL layout README.md: the status table has no rows")
+        failed += 1
+    header = rows[0][1] if rows else []
+    for number, cells in rows[1:]:
+        where = cells[-1] if cells else ""
+        if len(cells) != len(header):
+            print(f"FAIL layout README.md:{number}: {len(cells)} cells, the header has {len(header)}")
+            failed += 1
+        if not re.search(r"\]\(|`[^`]*/|`[^`]*\.md`", where):
+            print(f"FAIL layout README.md:{number}: the last cell does not name where it is measured "
+                  f"(a link or a path): '{where}'")
+            failed += 1
+        for cell in cells:
+            if len(cell) > LONGEST_CELL:
+                print(f"FAIL layout README.md:{number}: a cell of {len(cell)} characters "
+                      f"(a paragraph; at most {LONGEST_CELL}): '{cell[:60]}...'")
+                failed += 1
+    with open(os.path.join(root, "docs", "performance.md"), encoding="utf-8") as f:
+        screen = "".join(f.readlines()[:FIRST_SCREEN])
+    for what, pattern in (("a table of the figures", r"^\|.*\|$"), ("LIGGGHTS", r"LIGGGHTS"),
+                          ("the machines (a VM and its cores)", r"VM, \d+ cores"),
+                          ("a date", r"\d{4}-\d\d-\d\d"), ("a build", r"build[s]? [0-9a-f]{7}")):
+        if not re.search(pattern, screen, re.M):
+            print(f"FAIL layout docs/performance.md: its first {FIRST_SCREEN} lines lack {what}")
+            failed += 1
+    print(f"checkDocs layout: {len(rows) - 1} status rows and performance.md's first screen checked, "
+          f"{failed} failed")
+    return failed == 0
+
+
 def main(argv):
     if not argv or argv[0] in ("-h", "-help", "--help"):
         print(__doc__.strip())
@@ -330,9 +390,11 @@ def main(argv):
     if what == "commands":
         return 0 if check_commands(root, files[0] if files else
                                    os.path.join(root, "docs", "user-guide.md")) else 1
+    if what == "layout":
+        return 0 if check_layout(root) else 1
     if what == "words":
         return 0 if check_words(root, files or site_pages(root)) else 1
-    print(f"checkDocs.py: unknown check '{what}' (links, commands, words)", file=sys.stderr)
+    print(f"checkDocs.py: unknown check '{what}' (links, commands, words, layout)", file=sys.stderr)
     return 2
 
 
