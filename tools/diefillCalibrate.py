@@ -28,8 +28,9 @@ DICT (default ./calibrationDict) is an OpenFOAM-style dictionary:
 
 Method: a Latin-hypercube first sample, then one Gaussian-process surrogate per target and
 expected improvement of chi2 = sum ((y - value)/sigma)^2; it stops when a run agrees with every
-target within tolerance x sigma and no point promises an improvement above eiTolerance, or at
-maxRuns.  Output per stage in WORKDIR/STAGE/: runs.csv (every finished run), result.json (chosen
+target within tolerance x sigma and no point promises an improvement above eiTolerance (or above
+what the simulations' fitted scatter alone makes of chi2), or at maxRuns (then it is a success if a
+run agrees, exit 3 if none does).  Output per stage in WORKDIR/STAGE/: runs.csv (every finished run), result.json (chosen
 run, posterior mean, sd and 95 % interval per parameter), demPropertiesFragment, response.png,
 samples.png, convergence.png.  Run again after an interruption: finished runs are kept, a run
 that was stopped continues from its restart files.  docs/calibration.md has the details.
@@ -40,7 +41,7 @@ Options:
   -report        write the results and plots from the runs made so far; run nothing
   -stopAfter N   stop once N runs have finished in this call (run again to continue)
 Exit status: 0 done (every stage converged), 1 bad input or a failed run with onFailure stop,
-3 a stage used up maxRuns without agreeing with its targets (the later stages are not run),
+3 a stage used up maxRuns and no run agrees with its targets (the later stages are not run),
 4 stopped (-stopAfter or a signal) before the end."""
 import json
 import os
@@ -116,10 +117,14 @@ def main():
         print(f"    demProperties fragment: {os.path.join(r.folder, 'demPropertiesFragment')}; plots: "
               f"{os.path.join(r.folder, '{response,samples,convergence}.png')}", flush=True)
         if outcome == "budget" and not a.report:
-            print(f"diefillCalibrate: stage '{s.name}' used its {s.max_runs} runs (maxRuns) without a run within "
-                  f"{s.tolerance:g} sigma of every target and a settled surrogate; the later stages are not run. "
-                  f"Raise maxRuns (the runs made are kept) or widen the ranges", file=sys.stderr)
-            return 3
+            if not r.agrees:
+                print(f"diefillCalibrate: stage '{s.name}' used its {s.max_runs} runs (maxRuns) and no run agrees with "
+                      f"every target within {s.tolerance:g} sigma; the later stages are not run. Raise maxRuns (the runs "
+                      f"made are kept), widen the ranges, or tune other parameters", file=sys.stderr)
+                return 3
+            print(f"{s.name}: maxRuns reached; run {result['chosenRun']} agrees with the targets within "
+                  f"{s.tolerance:g} sigma, the surrogate still expected some improvement (raise maxRuns to refine "
+                  f"the posterior)", flush=True)
         carried.update(result["chosen"])
     return 0
 

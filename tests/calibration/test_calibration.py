@@ -339,8 +339,10 @@ def test_parallel():
     points = [r["interactions/sand-steel/friction"] for r in rows]
     check("runsInParallel 3: converges, each run in its own case once, no point twice",
           rc == 0 and len(set(points)) == len(points) == len(set(c[0] for c in calls(log))), f"exit {rc} {err[-300:]}")
-    check(f"runsInParallel 3: {len(rows)} one-second runs in {seconds:.1f} s (< 0.7 x serial)",
-          seconds < 0.7 * len(rows) * 1.0 + 3, seconds)
+    starts = sorted(float(c[-1]) for c in calls(log))
+    together = max(sum(1 for t in starts if s0 <= t < s0 + 0.9) for s0 in starts)
+    check(f"runsInParallel 3: 3 runs going at once (3 of the one-second runs started within 0.9 s; "
+          f"{len(rows)} runs in {seconds:.1f} s)", together >= 3, f"at most {together} at once; starts {starts}")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -399,6 +401,9 @@ if __name__ == "__main__":
         if "-endToEnd" in sys.argv:
             test_end_to_end()
     finally:
-        shutil.rmtree(TMP, ignore_errors=True)
+        if os.environ.get("CALIBRATION_TEST_KEEP"):
+            print(f"    test folders kept: {TMP}")
+        else:
+            shutil.rmtree(TMP, ignore_errors=True)
     print(f"calibration: {passed} passed, {failed} failed")
     sys.exit(1 if failed else 0)

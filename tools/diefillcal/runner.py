@@ -21,7 +21,7 @@ RECORD = "stage.json"
 RUN_PARAMETERS = "calibrationRun.json"
 RUN_LOG = "log.calibrationRun"
 # Results of an earlier run in the tutorial folder are not copied into a run's case.
-_NOT_COPIED = {"dem", "postProcessing", "runRecord", "setting"}
+_NOT_COPIED = {"dem", "postProcessing", "runRecord", "setting", ".diefill.lock"}
 
 
 class StopCalibration(Exception):
@@ -88,6 +88,7 @@ class StageRunner:
         self.stopping = False
         self.finished_here = 0
         self._design = None
+        self.agrees = False
         self.started = time.time()
 
     # ---- the record of what the runs mean, checked on restart -------------------------------
@@ -242,20 +243,24 @@ class StageRunner:
 
     # ---- the loop ---------------------------------------------------------------------------
     def converged(self):
-        """(converged, best row, largest expected improvement): a run agrees with every
-        target within tolerance x sigma, and no point promises an improvement of the misfit
-        above eiTolerance."""
+        """(converged, agrees, largest expected improvement, the improvement the scatter alone
+        explains).  Converged: a run agrees with every target within tolerance x sigma, and no
+        point promises an improvement of the misfit above eiTolerance, or above what the
+        simulations' own scatter makes of the misfit (sum of the fitted scatter^2 / sigma^2: a DEM
+        result moves by a fraction of a degree under a small change of the inputs, and a smaller
+        improvement could not be told from it)."""
         rows, x, y = self.finished_ok()
         if not rows:
-            return False, None, None
+            return False, False, None, None
         k = int(np.argmin([self.misfit(v) for v in y]))
         agrees = all(abs(v - t.value) <= self.s.tolerance * t.sigma for v, t in zip(y[k], self.s.targets))
         if len(rows) < 2 or len(self.table.rows) < self.s.min_runs:
-            return False, rows[k], None
+            return False, agrees, None, None
         s = self.surrogate(x, y)
         _, ei = method.propose(s, np.vstack([x, self._failed_points()]), self.misfit(y[k]), 1,
                                avoid=self._failed_points(), seed=self.c.seed)
-        return agrees and ei[0] < self.s.ei_tolerance, rows[k], ei[0]
+        scatter_floor = float(sum(m.noise_variance / t.sigma ** 2 for m, t in zip(s.models, self.s.targets)))
+        return agrees and ei[0] < max(self.s.ei_tolerance, scatter_floor), agrees, ei[0], scatter_floor
 
     def _stop_children(self, signum):
         for process, *_ in self.running.values():
@@ -289,6 +294,7 @@ class StageRunner:
                     if self.converged()[0]:
                         outcome = "converged"
                 if outcome is None and total >= self.s.max_runs:
+                    self.agrees = self.converged()[1]
                     outcome = "budget"
                 if outcome is None and (self.stopping or (stop_after is not None and self.finished_here >= stop_after)):
                     outcome = "stopped"
