@@ -12,7 +12,8 @@ DICT (default ./calibrationDict) is an OpenFOAM-style dictionary:
     threadsPerRun  1;               // demRun threads per simulation (Allrun -threads)
     onFailure      continue;        // continue | stop, when a run fails
     seed           1;
-    stages                          // run in this order; a stage keeps the earlier ones' results fixed
+    stages                          // run in this order; a stage keeps the earlier ones' results fixed;
+                                    // a stage without parameters is a check: one run at those values
     {
         plate
         {
@@ -108,6 +109,16 @@ def main():
         except ValueError as e:
             print(f"diefillCalibrate: error: {e}", file=sys.stderr)
             return 1
+        if not s.parameters:
+            shown = ", ".join(f"{k} {v:.4g} (target {result['targets'][k]['value']:g} +- {result['targets'][k]['sigma']:g})"
+                              for k, v in result["chosenTargets"].items())
+            if not result["agrees"]:
+                print(f"diefillCalibrate: check stage '{s.name}': the case at the earlier stages' values gives {shown}: "
+                      f"not within {s.tolerance:g} sigma (the later stage moved it; tune this case's parameters again "
+                      f"in a further stage with the others kept)", file=sys.stderr)
+                return 3
+            print(f"{s.name}: check run at the earlier stages' values: {shown}: agrees", flush=True)
+            continue
         print(f"{s.name}: {outcome} after {result['runs']} runs ({result['failedRuns']} failed, "
               f"{result['simulationSeconds'] / 60:.1f} min of simulation); chosen run {result['chosenRun']}: "
               + ", ".join(f"{t} {v:.4g}" for t, v in result["chosenTargets"].items()), flush=True)

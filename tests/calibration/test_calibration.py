@@ -299,6 +299,11 @@ stages
         parameters { interactions/sand-sand/friction (0.3 0.9); }
         targets { reposeAngle { value 28; sigma 0.3; } }
     }
+    plateCheck
+    {
+        case "$DIEFILL_DIR/tests/calibration/syntheticCase";
+        targets { angleAt50PercentSlid { value 26.2; sigma 0.3; } }
+    }
 }
 """
     folder = write_dict(os.path.join(TMP, "two"), text)
@@ -323,6 +328,18 @@ stages
     frag = open(os.path.join(folder, "work", "repose", "demPropertiesFragment")).read()
     check("demPropertiesFragment: an 'interactions { sand-sand { friction V; } }' block",
           f"sand-sand {{ friction {mu:.4g}; }}" in frag, frag)
+    check_rows = read_table(os.path.join(folder, "work", "plateCheck", "runs.csv"))
+    props = os.path.join(folder, "work", "plateCheck", "runs", "run0001", "constant", "demProperties")
+    check("check stage (no parameters): one run holding both stages' values, agrees, exit 0",
+          rc == 0 and len(check_rows) == 1 and "check run" in out and "agrees" in out
+          and abs(casefile.read_value(props, "interactions/sand-sand/friction") - mu) < 1e-9
+          and abs(casefile.read_value(props, "interactions/sand-steel/friction") - muw) < 1e-9, f"{rc} {out[-300:]}")
+    moved = write_dict(os.path.join(TMP, "two"), text.replace("value 26.2; sigma 0.3; } }\n    }\n}",
+                                                                "value 20; sigma 0.3; } }\n    }\n}"))
+    shutil.rmtree(os.path.join(moved, "work", "plateCheck"))
+    rc, out, err = run_tool(moved)
+    check("check stage that does not agree: exit 3 naming the stage and the target", rc == 3
+          and "plateCheck" in err and "angleAt50PercentSlid" in err and "not within" in err, f"{rc} {err[-300:]}")
     pngs = [p for p in ("response.png", "samples.png", "convergence.png")
             if os.path.getsize(os.path.join(folder, "work", "plate", p)) > 5000]
     check("plots written: response, samples, convergence", len(pngs) == 3, pngs)
@@ -391,15 +408,16 @@ stages
 
 if __name__ == "__main__":
     quick_only = "-quickOnly" in sys.argv
+    tests = [test_method, test_casefile, test_errors, test_restart, test_two_stages, test_parallel]
+    if "-endToEnd" in sys.argv:
+        tests.append(test_end_to_end)
     try:
-        test_method()
-        test_casefile()
-        test_errors()
-        test_restart()
-        test_two_stages()
-        test_parallel()
-        if "-endToEnd" in sys.argv:
-            test_end_to_end()
+        for test in tests:
+            try:
+                test()
+            except Exception:           # one broken test must not hide the others
+                import traceback
+                check(f"{test.__name__} ran to its end", False, traceback.format_exc())
     finally:
         if os.environ.get("CALIBRATION_TEST_KEEP"):
             print(f"    test folders kept: {TMP}")

@@ -135,18 +135,11 @@ def read(path, work_dir=None):
     stages = d.get("stages")
     if not isinstance(stages, dict) or not stages:
         raise InputError(f"{path}: keyword 'stages' is missing or empty; expected stages {{ NAME {{ case ...; parameters {{...}} targets {{...}} }} }}")
-    tuned_before = {}
     for name, sd in stages.items():
         where = f"{path}: stages/{name}"
         if not isinstance(sd, dict):
             raise InputError(f"{where}: expected a dictionary")
         s = _read_stage(name, sd, where, base)
-        for p in s.parameters:
-            if p.keyword in tuned_before:
-                raise InputError(f"{where}/parameters: '{p.keyword}' is tuned in stage '{tuned_before[p.keyword]}' "
-                                 f"already, whose result this stage keeps fixed; tune it in one stage only")
-        for p in s.parameters:
-            tuned_before[p.keyword] = name
         c.stages.append(s)
     # A later stage receives the earlier stages' results: their keywords must exist in its case.
     for i, s in enumerate(c.stages):
@@ -196,9 +189,10 @@ def _read_stage(name, sd, where, base):
             raise InputError(f"{where}/fixed: '{keyword}' is {value!r}; expected a number")
         _check_limits(keyword, [value], f"{where}/fixed")
         s.fixed[keyword] = value
-    params = sd.get("parameters")
-    if not isinstance(params, dict) or not params:
-        raise InputError(f"{where}: keyword 'parameters' is missing or empty; expected e.g. "
+    # No parameters: a check stage, one run of the case at the earlier stages' results.
+    params = sd.get("parameters", {})
+    if not isinstance(params, dict):
+        raise InputError(f"{where}: keyword 'parameters' expected a dictionary, e.g. "
                          f"parameters {{ interactions/sand-steel/friction (0.3 0.9); }}")
     for keyword, rng in params.items():
         keyword_in_case(keyword, "parameters")
@@ -223,6 +217,10 @@ def _read_stage(name, sd, where, base):
                              f"it reports: {', '.join(sorted(known))}")
         s.targets.append(Target(key, _number(td, "value", tw), _number(td, "sigma", tw, None, 1e-300)))
     d = len(s.parameters)
+    if d == 0:
+        s.initial_runs = s.min_runs = s.max_runs = 1
+        s.tolerance = _number(sd, "tolerance", where, 1.0, 1e-6)
+        return s
     s.initial_runs = _number(sd, "initialRuns", where, max(4, 2 * d + 2), 2, None, True)
     s.min_runs = _number(sd, "minRuns", where, s.initial_runs + 1, 1, None, True)
     s.max_runs = _number(sd, "maxRuns", where, max(4 * s.initial_runs, s.min_runs), 1, None, True)

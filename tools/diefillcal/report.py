@@ -14,13 +14,18 @@ def summarise(runner, outcome, wall_seconds):
     """result.json, demPropertiesFragment and the plots of a stage; returns the result dict."""
     s = runner.s
     rows, x, y = runner.finished_ok()
-    if len(rows) < 2:
-        raise ValueError(f"stage '{s.name}': {len(rows)} successful run(s) in {runner.folder}; the posterior needs "
-                         f"at least 2 (see the failed runs' messages in {os.path.join(runner.folder, 'runs.csv')})")
+    needed = 2 if s.parameters else 1
+    if len(rows) < needed:
+        raise ValueError(f"stage '{s.name}': {len(rows)} successful run(s) in {runner.folder}; "
+                         + ("the posterior needs at least 2" if s.parameters else "the check run failed")
+                         + f" (see the failed runs' messages in {os.path.join(runner.folder, 'runs.csv')})")
     misfits = np.array([runner.misfit(v) for v in y])
     k = int(np.argmin(misfits))
-    surrogate = runner.surrogate(x, y)
-    post = method.posterior(surrogate, seed=runner.c.seed)
+    if s.parameters:
+        surrogate = runner.surrogate(x, y)
+        post = method.posterior(surrogate, seed=runner.c.seed)
+    else:
+        surrogate, post = None, {"mean": [], "std": [], "quantiles": [], "ess": 0.0}
     chosen = {p.keyword: float(p.from_unit(x[k, i])) for i, p in enumerate(s.parameters)}
     width = np.array([p.high - p.low for p in s.parameters])
     result = {
@@ -43,9 +48,13 @@ def summarise(runner, outcome, wall_seconds):
                                   "range": [p.low, p.high]} for i, p in enumerate(s.parameters)},
         "posteriorEffectiveSamples": post["ess"],
         "fixed": {**runner.carried, **s.fixed},
-        "surrogateScatter": {t.key: float(np.sqrt(m.noise_variance)) for t, m in zip(s.targets, surrogate.models)},
+        "surrogateScatter": {t.key: float(np.sqrt(m.noise_variance)) for t, m in zip(s.targets, surrogate.models)}
+        if surrogate else {},
+        "agrees": bool(all(abs(y[k, j] - t.value) <= s.tolerance * t.sigma for j, t in enumerate(s.targets))),
     }
     _write_atomically(os.path.join(runner.folder, "result.json"), json.dumps(result, indent=1))
+    if not s.parameters:
+        return result
     _write_atomically(os.path.join(runner.folder, "demPropertiesFragment"), fragment(result))
     try:
         plots(runner, surrogate, post, x, y, k)

@@ -111,12 +111,15 @@ class StageRunner:
         self.table = RunTable(os.path.join(self.folder, TABLE))
 
     # ---- the points ---------------------------------------------------------------------------
+    def _points(self, rows):
+        d = len(self.s.parameters)
+        return np.array([[p.to_unit(float(r[p.keyword])) for p in self.s.parameters] for r in rows],
+                        float).reshape(len(rows), d)
+
     def finished_ok(self):
         rows = [r for r in self.table.rows if r["status"] == "ok"]
-        x = np.array([[self.s.parameters[k].to_unit(float(r[p.keyword])) for k, p in enumerate(self.s.parameters)]
-                      for r in rows]).reshape(-1, len(self.s.parameters))
-        y = np.array([[float(r[t.key]) for t in self.s.targets] for r in rows]).reshape(-1, len(self.s.targets))
-        return rows, x, y
+        y = np.array([[float(r[t.key]) for t in self.s.targets] for r in rows], float).reshape(len(rows), len(self.s.targets))
+        return rows, self._points(rows), y
 
     def misfit(self, values):
         return float(sum(((v - t.value) / t.sigma) ** 2 for v, t in zip(values, self.s.targets)))
@@ -131,13 +134,14 @@ class StageRunner:
                                 seed=self.c.seed)
 
     def _failed_points(self):
-        return np.array([[self.s.parameters[k].to_unit(float(r[p.keyword])) for k, p in enumerate(self.s.parameters)]
-                         for r in self.table.rows if r["status"] != "ok"]).reshape(-1, len(self.s.parameters))
+        return self._points([r for r in self.table.rows if r["status"] != "ok"])
 
     def next_point(self, run_id):
         """Unit-cube point of run `run_id`: the design's for the first runs, then the
         surrogate's proposal with the running points believed."""
         d = len(self.s.parameters)
+        if d == 0:
+            return np.zeros(0), "check at the earlier stages' values"
         if run_id <= self.s.initial_runs:
             return self.design()[run_id - 1], "design"
         _, x, y = self.finished_ok()
@@ -254,6 +258,8 @@ class StageRunner:
             return False, False, None, None
         k = int(np.argmin([self.misfit(v) for v in y]))
         agrees = all(abs(v - t.value) <= self.s.tolerance * t.sigma for v, t in zip(y[k], self.s.targets))
+        if not self.s.parameters:
+            return agrees, agrees, None, None
         if len(rows) < 2 or len(self.table.rows) < self.s.min_runs:
             return False, agrees, None, None
         s = self.surrogate(x, y)
