@@ -24,6 +24,7 @@ DICT (default ./calibrationDict) is an OpenFOAM-style dictionary:
             parameters { interactions/sand-steel/friction (0.3 0.9); }
             targets    { angleAt50PercentSlid { value 29; sigma 1.5; } }   // keys of postProcessing/results.json
             initialRuns 4;  minRuns 5;  maxRuns 16;  tolerance 1;  eiTolerance 0.01;   // optional
+            choose     nearest;   // of the runs that agree, the one nearest the case's values (or: best)
         }
     }
 
@@ -71,10 +72,11 @@ def main():
         return 1
     if a.check:
         for s in c.stages:
-            print(f"{s.name}: {s.case} ({s.setting}); parameters "
-                  + ", ".join(f"{p.keyword} {p.low:g}-{p.high:g}" for p in s.parameters) + "; targets "
-                  + ", ".join(f"{t.key} {t.value:g} +- {t.sigma:g}" for t in s.targets)
-                  + f"; {s.initial_runs} design runs, at most {s.max_runs}")
+            what = ("parameters " + ", ".join(f"{p.keyword} {p.low:g}-{p.high:g}" for p in s.parameters)
+                    + f"; {s.initial_runs} first-sample runs, at most {s.max_runs}") if s.parameters \
+                else "a check: one run at the earlier stages' values"
+            print(f"{s.name}: {s.case} ({s.setting}); {what}; targets "
+                  + ", ".join(f"{t.key} {t.value:g} +- {t.sigma:g}" for t in s.targets))
         print(f"diefillCalibrate: {a.dict} is fine; work folder {c.work_dir}")
         return 0
     carried = {}

@@ -345,6 +345,44 @@ stages
     check("plots written: response, samples, convergence", len(pngs) == 3, pngs)
 
 
+def test_choose():
+    # one target, two parameters: the agreeing runs lie on a ridge (12 + 22 muW + 6 murW = 26.2)
+    text = '''workDir work;
+stages
+{
+    plate
+    {
+        case "$DIEFILL_DIR/tests/calibration/syntheticCase";
+        parameters { interactions/sand-steel/friction (0.3 0.9); interactions/sand-steel/rollingFriction (0.1 0.9); }
+        targets { angleAt50PercentSlid { value 26.2; sigma 1.0; } }
+        maxRuns 10;
+        CHOOSE
+    }
+}
+'''
+    start = np.array([0.61, 0.50])                # the synthetic case's own values
+    width = np.array([0.6, 0.8])
+    out = {}
+    for rule in ("best", "nearest"):
+        folder = write_dict(os.path.join(TMP, "choose-" + rule), text.replace("CHOOSE", f"choose {rule};"))
+        rc, _, err = run_tool(folder)
+        r = json.load(open(os.path.join(folder, "work", "plate", "result.json")))
+        rows = [row for row in read_table(os.path.join(folder, "work", "plate", "runs.csv")) if row["status"] == "ok"]
+        agreeing = [np.array([float(row["interactions/sand-steel/friction"]), float(row["interactions/sand-steel/rollingFriction"])])
+                    for row in rows if abs(float(row["angleAt50PercentSlid"]) - 26.2) <= 1.0]
+        chosen = np.array([r["chosen"]["interactions/sand-steel/friction"], r["chosen"]["interactions/sand-steel/rollingFriction"]])
+        out[rule] = (rc, chosen, agreeing, r)
+    rc, chosen, agreeing, r = out["nearest"]
+    distances = [float(np.linalg.norm((a - start) / width)) for a in agreeing]
+    check("choose nearest: of the runs within sigma, the one nearest the case's own values (0.61, 0.50)",
+          rc == 0 and r["agrees"] and abs(float(np.linalg.norm((chosen - start) / width)) - min(distances)) < 1e-9,
+          f"exit {rc}, chosen {chosen}, distances {distances}")
+    rc_b, chosen_b, _, r_b = out["best"]
+    check("choose best: the run of smallest misfit (an agreeing one at least as far from the start as nearest's)",
+          rc_b == 0 and r_b["chosenMisfit"] <= r["chosenMisfit"] + 1e-12
+          and float(np.linalg.norm((chosen_b - start) / width)) >= min(distances) - 1e-9, f"{chosen_b} {r_b['chosenMisfit']}")
+
+
 def test_parallel():
     text = one_stage(value=27.3, sigma=0.3, top="runsInParallel 3;")
     folder = write_dict(os.path.join(TMP, "parallel"), text)
@@ -408,7 +446,7 @@ stages
 
 if __name__ == "__main__":
     quick_only = "-quickOnly" in sys.argv
-    tests = [test_method, test_casefile, test_errors, test_restart, test_two_stages, test_parallel]
+    tests = [test_method, test_casefile, test_errors, test_restart, test_two_stages, test_choose, test_parallel]
     if "-endToEnd" in sys.argv:
         tests.append(test_end_to_end)
     try:

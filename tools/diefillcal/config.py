@@ -50,6 +50,7 @@ class Stage:
         self.max_runs = None
         self.tolerance = 1.0
         self.ei_tolerance = 0.01
+        self.choose = "nearest"
 
     def record(self, carried):
         """What the runs of this stage mean: a restart with any of it changed is refused."""
@@ -157,7 +158,7 @@ def read(path, work_dir=None):
 def _read_stage(name, sd, where, base):
     s = Stage(name)
     _unknown_keys(sd, ["case", "setting", "allrunOptions", "fixed", "parameters", "targets", "initialRuns",
-                       "minRuns", "maxRuns", "tolerance", "eiTolerance"], where)
+                       "minRuns", "maxRuns", "tolerance", "eiTolerance", "choose"], where)
     if "case" not in sd:
         raise InputError(f"{where}: keyword 'case' is missing; expected the folder of a case with an Allrun (a tutorial)")
     case = os.path.expandvars(str(sd["case"]))
@@ -228,6 +229,7 @@ def _read_stage(name, sd, where, base):
         raise InputError(f"{where}: keyword 'maxRuns' is {s.max_runs}; expected at least initialRuns ({s.initial_runs})")
     s.tolerance = _number(sd, "tolerance", where, 1.0, 1e-6)
     s.ei_tolerance = _number(sd, "eiTolerance", where, 0.01, 0.0)
+    s.choose = _word(sd, "choose", where, ("nearest", "best"), "nearest")
     return s
 
 

@@ -20,7 +20,7 @@ def summarise(runner, outcome, wall_seconds):
                          + ("the posterior needs at least 2" if s.parameters else "the check run failed")
                          + f" (see the failed runs' messages in {os.path.join(runner.folder, 'runs.csv')})")
     misfits = np.array([runner.misfit(v) for v in y])
-    k = int(np.argmin(misfits))
+    k = choose(runner, x, y)
     if s.parameters:
         surrogate = runner.surrogate(x, y)
         post = method.posterior(surrogate, seed=runner.c.seed)
@@ -38,6 +38,8 @@ def summarise(runner, outcome, wall_seconds):
         "simulationSeconds": float(sum(float(r["seconds"]) for r in runner.table.rows)),
         "wallSecondsThisCall": wall_seconds,
         "chosenRun": int(rows[k]["run"]),
+        "choose": s.choose,
+        "start": {p.keyword: runner.start_values()[i] for i, p in enumerate(s.parameters)},
         "chosen": chosen,
         "chosenTargets": {t.key: float(y[k, j]) for j, t in enumerate(s.targets)},
         "targets": {t.key: {"value": t.value, "sigma": t.sigma} for t in s.targets},
@@ -61,6 +63,25 @@ def summarise(runner, outcome, wall_seconds):
     except Exception as e:  # a plot must not lose a calibration that took hours
         print(f"{s.name}: plots not written ({e})", flush=True)
     return result
+
+
+def choose(runner, x, y):
+    """Index of the chosen run among the good ones: 'best' the smallest chi2; 'nearest' (the
+    default) of the runs that agree with every target within tolerance x sigma the one nearest
+    to the case's own values (distance in range units; with fewer targets than parameters the
+    agreeing runs lie along a ridge, and this keeps the calibrated set as close to the given one
+    as the data allow), the smallest chi2 when none agrees."""
+    s = runner.s
+    misfits = np.array([runner.misfit(v) for v in y])
+    best = int(np.argmin(misfits))
+    if s.choose == "best" or not s.parameters:
+        return best
+    agree = [i for i in range(len(y)) if all(abs(y[i, j] - t.value) <= s.tolerance * t.sigma
+                                              for j, t in enumerate(s.targets))]
+    if not agree:
+        return best
+    start = np.array([p.to_unit(v) for p, v in zip(s.parameters, runner.start_values())])
+    return min(agree, key=lambda i: float(np.sum((x[i] - start) ** 2)))
 
 
 def fragment(result):
@@ -118,6 +139,7 @@ def plots(runner, surrogate, post, x, y, k):
     s = runner.s
     d, m = len(s.parameters), len(s.targets)
     phys = np.array([[p.from_unit(u) for p, u in zip(s.parameters, row)] for row in x])
+    start = runner.start_values()
 
     # response of each target to each parameter (the others at the chosen run's values)
     fig, axes = plt.subplots(m, d, figsize=(4.2 * d, 3.4 * m), squeeze=False)
@@ -132,7 +154,7 @@ def plots(runner, surrogate, post, x, y, k):
                             color="C0", alpha=0.2, label="surrogate ± 2 sd" + (" (others at chosen)" if d > 1 else ""))
             ax.plot(u, mean[:, j], color="C0")
             ax.axhspan(t.value - t.sigma, t.value + t.sigma, color="C2", alpha=0.2, label="target ± sigma")
-            ax.scatter(phys[:, i], y[:, j], color="k", s=14, label="runs")
+            ax.scatter(phys[:, i], y[:, j], color="k", s=14, label="runs" + (" (other parameters as they were)" if d > 1 else ""))
             ax.scatter([phys[k, i]], [y[k, j]], color="C3", marker="*", s=120, label="chosen", zorder=5)
             ax.set_xlabel(p.keyword)
             ax.set_ylabel(t.key)
@@ -155,6 +177,7 @@ def plots(runner, surrogate, post, x, y, k):
         for n, v in enumerate(phys[:, 0]):
             ax.annotate(str(n + 1), (v, 0.02), fontsize=7)
         ax.axvline(phys[k, 0], color="C3", label="chosen")
+        ax.axvline(start[0], color="C1", ls="--", label="the case's own value")
         ax.set_xlabel(s.parameters[0].keyword)
         ax.legend(fontsize=8)
     else:
@@ -171,6 +194,7 @@ def plots(runner, surrogate, post, x, y, k):
                 sc = ax.scatter(phys[:, b], phys[:, a], c=np.log10(misfit + 1e-3), cmap="viridis_r", edgecolor="k",
                                 s=30, label="runs (colour: log10 misfit)")
                 ax.scatter([phys[k, b]], [phys[k, a]], color="C3", marker="*", s=160, label="chosen")
+                ax.scatter([start[b]], [start[a]], color="C1", marker="x", s=80, label="the case's own values")
                 ax.set_xlim(s.parameters[b].low, s.parameters[b].high)
                 ax.set_ylim(s.parameters[a].low, s.parameters[a].high)
                 ax.set_xlabel(s.parameters[b].keyword)

@@ -121,6 +121,11 @@ class StageRunner:
         y = np.array([[float(r[t.key]) for t in self.s.targets] for r in rows], float).reshape(len(rows), len(self.s.targets))
         return rows, self._points(rows), y
 
+    def start_values(self):
+        """The case's own value of each parameter (an earlier stage's result when it tuned it)."""
+        source = casefile.source_file(self.s.case)
+        return [float(self.carried.get(p.keyword, casefile.read_value(source, p.keyword))) for p in self.s.parameters]
+
     def misfit(self, values):
         return float(sum(((v - t.value) / t.sigma) ** 2 for v, t in zip(values, self.s.targets)))
 
