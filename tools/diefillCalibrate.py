@@ -91,6 +91,9 @@ def main():
             if a.report:
                 r.open()
                 outcome = "report"
+                if not r.table.rows:
+                    print(f"{s.name}: no finished run yet in {r.folder}", flush=True)
+                    return 0
             else:
                 print(f"{s.name}: case {s.case} ({s.setting}), work folder {r.folder}", flush=True)
                 outcome = r.run(stop_after=stop_after)
