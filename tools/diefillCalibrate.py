@@ -25,10 +25,11 @@ DICT (default ./calibrationDict) is an OpenFOAM-style dictionary:
             targets    { angleAt50PercentSlid { value 29; sigma 1.5; } }   // keys of postProcessing/results.json
             initialRuns 4;  minRuns 5;  maxRuns 16;  tolerance 1;  eiTolerance 0.01;   // optional
             choose     nearest;   // of the runs that agree, the one nearest the case's values (or: best)
+            startRun   yes;       // the first run at the case's own values (no: the design only)
         }
     }
 
-Method: a Latin-hypercube first sample, then one Gaussian-process surrogate per target and
+Method: a run at the case's own values and a Latin-hypercube first sample, then one Gaussian-process surrogate per target and
 expected improvement of chi2 = sum ((y - value)/sigma)^2; it stops when a run agrees with every
 target within tolerance x sigma and no point promises an improvement above eiTolerance (or above
 what the simulations' fitted scatter alone makes of chi2), or at maxRuns (then it is a success if a
@@ -73,7 +74,8 @@ def main():
     if a.check:
         for s in c.stages:
             what = ("parameters " + ", ".join(f"{p.keyword} {p.low:g}-{p.high:g}" for p in s.parameters)
-                    + f"; {s.initial_runs} first-sample runs, at most {s.max_runs}") if s.parameters \
+                    + f"; {s.first_runs} first-sample runs"
+                    + (" (the case's own values first)" if s.start_run else "") + f", at most {s.max_runs}") if s.parameters \
                 else "a check: one run at the earlier stages' values"
             print(f"{s.name}: {s.case} ({s.setting}); {what}; targets "
                   + ", ".join(f"{t.key} {t.value:g} +- {t.sigma:g}" for t in s.targets))

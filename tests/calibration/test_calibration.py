@@ -383,6 +383,22 @@ stages
           and float(np.linalg.norm((chosen_b - start) / width)) >= min(distances) - 1e-9, f"{chosen_b} {r_b['chosenMisfit']}")
 
 
+def test_start_run():
+    # the case's own sand-steel friction, 0.61, gives 12 + 22 x 0.61 + 6 x 0.5 = 28.42 in the synthetic case
+    folder = write_dict(os.path.join(TMP, "start"), one_stage(value=28.6, sigma=0.5))
+    rc, out, err = run_tool(folder)
+    marker = json.load(open(os.path.join(folder, "work", "plate", "runs", "run0001", "calibrationRun.json")))
+    r = json.load(open(os.path.join(folder, "work", "plate", "result.json")))
+    check("startRun (default): run 1 is the case's own value (0.61); it agrees, so 'nearest' keeps it",
+          rc == 0 and abs(marker["values"]["interactions/sand-steel/friction"] - 0.61) < 1e-12
+          and r["chosenRun"] == 1 and abs(r["chosen"]["interactions/sand-steel/friction"] - 0.61) < 1e-12,
+          f"exit {rc}, run 1 {marker['values']}, chosen run {r['chosenRun']} {r['chosen']}")
+    folder = write_dict(os.path.join(TMP, "nostart"), one_stage(value=28.6, sigma=0.5, extra="startRun no;"))
+    rc, out, err = run_tool(folder)
+    marker = json.load(open(os.path.join(folder, "work", "plate", "runs", "run0001", "calibrationRun.json")))
+    check("startRun no: run 1 is the first design point", rc == 0 and marker["why"] == "design", marker)
+
+
 def test_parallel():
     text = one_stage(value=27.3, sigma=0.3, top="runsInParallel 3;")
     folder = write_dict(os.path.join(TMP, "parallel"), text)
@@ -421,7 +437,7 @@ stages
         parameters {{ interactions/sand-steel/friction (0.25 0.85); }}
         targets {{ angleAt50PercentSlid {{ value {target}; sigma 0.5; }} }}
         initialRuns 4;
-        maxRuns 8;
+        maxRuns 10;
     }}
 }}
 """
@@ -446,7 +462,7 @@ stages
 
 if __name__ == "__main__":
     quick_only = "-quickOnly" in sys.argv
-    tests = [test_method, test_casefile, test_errors, test_restart, test_two_stages, test_choose, test_parallel]
+    tests = [test_method, test_casefile, test_errors, test_restart, test_two_stages, test_choose, test_start_run, test_parallel]
     if "-endToEnd" in sys.argv:
         tests.append(test_end_to_end)
     try:

@@ -51,13 +51,19 @@ class Stage:
         self.tolerance = 1.0
         self.ei_tolerance = 0.01
         self.choose = "nearest"
+        self.start_run = True
+
+    @property
+    def first_runs(self):
+        """Runs before the surrogate proposes: the case's own values (startRun) and the design."""
+        return self.initial_runs + (1 if self.start_run and self.parameters else 0)
 
     def record(self, carried):
         """What the runs of this stage mean: a restart with any of it changed is refused."""
         return {"case": self.case, "setting": self.setting, "allrunOptions": self.allrun_options,
                 "fixed": {**carried, **self.fixed},
                 "parameters": [[p.keyword, p.low, p.high] for p in self.parameters],
-                "initialRuns": self.initial_runs}
+                "initialRuns": self.initial_runs, "startRun": self.start_run}
 
 
 class Calibration:
@@ -158,7 +164,7 @@ def read(path, work_dir=None):
 def _read_stage(name, sd, where, base):
     s = Stage(name)
     _unknown_keys(sd, ["case", "setting", "allrunOptions", "fixed", "parameters", "targets", "initialRuns",
-                       "minRuns", "maxRuns", "tolerance", "eiTolerance", "choose"], where)
+                       "minRuns", "maxRuns", "tolerance", "eiTolerance", "choose", "startRun"], where)
     if "case" not in sd:
         raise InputError(f"{where}: keyword 'case' is missing; expected the folder of a case with an Allrun (a tutorial)")
     case = os.path.expandvars(str(sd["case"]))
@@ -222,11 +228,14 @@ def _read_stage(name, sd, where, base):
         s.initial_runs = s.min_runs = s.max_runs = 1
         s.tolerance = _number(sd, "tolerance", where, 1.0, 1e-6)
         return s
+    s.start_run = _word(sd, "startRun", where, ("yes", "no"), "yes") == "yes"
     s.initial_runs = _number(sd, "initialRuns", where, max(4, 2 * d + 2), 2, None, True)
-    s.min_runs = _number(sd, "minRuns", where, s.initial_runs + 1, 1, None, True)
-    s.max_runs = _number(sd, "maxRuns", where, max(4 * s.initial_runs, s.min_runs), 1, None, True)
-    if s.max_runs < s.initial_runs:
-        raise InputError(f"{where}: keyword 'maxRuns' is {s.max_runs}; expected at least initialRuns ({s.initial_runs})")
+    s.min_runs = _number(sd, "minRuns", where, s.first_runs + 1, 1, None, True)
+    s.max_runs = _number(sd, "maxRuns", where, max(4 * s.initial_runs + s.first_runs - s.initial_runs, s.min_runs),
+                         1, None, True)
+    if s.max_runs < s.first_runs:
+        raise InputError(f"{where}: keyword 'maxRuns' is {s.max_runs}; expected at least the first sample's "
+                         f"{s.first_runs} runs (initialRuns{' + the start run' if s.start_run else ''})")
     s.tolerance = _number(sd, "tolerance", where, 1.0, 1e-6)
     s.ei_tolerance = _number(sd, "eiTolerance", where, 0.01, 0.0)
     s.choose = _word(sd, "choose", where, ("nearest", "best"), "nearest")

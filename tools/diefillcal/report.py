@@ -125,7 +125,7 @@ def history(runner, x_all_rows):
     out = []
     ok_rows, x, y = runner.finished_ok()
     order = [int(r["run"]) for r in ok_rows]
-    for n in range(max(2, min(s.initial_runs, len(order))), len(order) + 1):
+    for n in range(max(2, min(s.first_runs, len(order))), len(order) + 1):
         sur = runner.surrogate(x[:n], y[:n])
         post = method.posterior(sur, rounds=2, n=2048, seed=runner.c.seed)
         out.append((n, post["mean"], post["std"]))
@@ -216,7 +216,7 @@ def plots(runner, surrogate, post, x, y, k):
     ax.semilogy(range(1, len(misfit_all) + 1), np.maximum(misfit_all, 1e-4), "o", color="k", ms=3, label="run")
     ax.semilogy(range(1, len(best) + 1), np.maximum(best, 1e-4), color="C3", label="best so far")
     ax.axhline(len(s.targets) * s.tolerance ** 2, color="C2", ls="--", label="tolerance")
-    ax.axvline(s.initial_runs + 0.5, color="0.6", ls=":", label="end of the design")
+    ax.axvline(s.first_runs + 0.5, color="0.6", ls=":", label="end of the first sample")
     ax.set_xlabel("run")
     ax.set_ylabel("misfit chi2")
     ax.legend(fontsize=7)

@@ -147,8 +147,11 @@ class StageRunner:
         d = len(self.s.parameters)
         if d == 0:
             return np.zeros(0), "check at the earlier stages' values"
-        if run_id <= self.s.initial_runs:
-            return self.design()[run_id - 1], "design"
+        if self.s.start_run and run_id == 1:
+            start = [p.to_unit(v) for p, v in zip(self.s.parameters, self.start_values())]
+            return np.clip(start, 0.0, 1.0), "the case's own values"
+        if run_id <= self.s.first_runs:
+            return self.design()[run_id - 1 - (self.s.first_runs - self.s.initial_runs)], "design"
         _, x, y = self.finished_ok()
         if len(x) < 2:
             # too few good runs for a surrogate (failures): more space-filling points
@@ -316,7 +319,7 @@ class StageRunner:
                         else:
                             used = self.table.ids() | set(self.running)
                             # the design's runs first, then the surrogate's
-                            missing = [i for i in range(1, self.s.initial_runs + 1) if i not in used]
+                            missing = [i for i in range(1, self.s.first_runs + 1) if i not in used]
                             run_id = missing[0] if missing else max(used | {0}) + 1
                             point, why = self.next_point(run_id)
                         if self.stopping:           # a signal came while the point was chosen
