@@ -46,7 +46,6 @@ Options:
 Exit status: 0 done (every stage converged), 1 bad input or a failed run with onFailure stop,
 3 a stage used up maxRuns and no run agrees with its targets (the later stages are not run),
 4 stopped (-stopAfter or a signal) before the end."""
-import json
 import os
 import sys
 import time

@@ -1,13 +1,13 @@
 """Running a stage: case copies, the table of finished runs, restart, the loop that fills
 the free slots with the design's points and then with the surrogate's proposals."""
 import csv
+import io
 import json
 import math
 import os
 import shutil
 import signal
 import subprocess
-import sys
 import time
 
 import numpy as np
@@ -56,7 +56,6 @@ class RunTable:
         columns = []
         for r in self.rows:
             columns += [k for k in r if k not in columns]
-        import io
         buffer = io.StringIO()
         w = csv.DictWriter(buffer, columns, restval="")
         w.writeheader()
