@@ -211,6 +211,13 @@ def test_errors():
     rows = read_table(os.path.join(folder, "work", "plate", "runs.csv"))
     check("failed run with onFailure stop: the failed run is in the table with its log",
           any(r["status"] == "failed" and "log.calibrationRun" in r["message"] for r in rows), rows)
+    # a case locked by a simulation of an earlier call (killed with SIGKILL): stop, record nothing
+    folder = expect_error("a run's case in use by another process", one_stage(),
+                          ["run 1's case", "in use by another process", "Wait for it"],
+                          env={"SYNTHETIC_LOCKED": "1"}, created=True)
+    table = os.path.join(folder, "work", "plate", "runs.csv")
+    check("a locked case: the run is not recorded (it is not a result)",
+          not os.path.exists(table) or not read_table(table), open(table).read() if os.path.exists(table) else "")
     # onFailure continue: the failures are recorded, the calibration goes on and ends
     # (6 design runs: one in [0.8, 0.9], which fails, one in [0.7, 0.8], whose target is null)
     folder = write_dict(os.path.join(TMP, "fail-continue"), one_stage(extra="initialRuns 6;"))

@@ -218,6 +218,12 @@ class StageRunner:
         rc = process.returncode
         if rc != 0:
             tail = open(log_path, errors="replace").read().strip().splitlines()[-8:]
+            if rc == 2 and any("is in use by process" in line for line in tail):
+                # The case lock of the tutorials: a run of an earlier call, killed without its
+                # simulations (SIGKILL), still goes on in this folder.  Not a result: not recorded.
+                raise StopCalibration(f"stage '{self.s.name}': run {run_id}'s case {folder} is in use by another "
+                                      f"process ({' '.join(tail[-1:])}): an earlier diefillCalibrate's simulation "
+                                      f"still running? Wait for it or end it, then run again")
             message = f"Allrun exited with status {rc}; log: {log_path}; last lines: " + " | ".join(tail)
         else:
             path = os.path.join(folder, "postProcessing", "results.json")
