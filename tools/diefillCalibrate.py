@@ -29,14 +29,15 @@ DICT (default ./calibrationDict) is an OpenFOAM-style dictionary:
         }
     }
 
-Method: a run at the case's own values and a Latin-hypercube first sample, then one Gaussian-process surrogate per target and
-expected improvement of chi2 = sum ((y - value)/sigma)^2; it stops when a run agrees with every
-target within tolerance x sigma and no point promises an improvement above eiTolerance (or above
-what the simulations' fitted scatter alone makes of chi2), or at maxRuns (then it is a success if a
-run agrees, exit 3 if none does).  Output per stage in WORKDIR/STAGE/: runs.csv (every finished run), result.json (chosen
-run, posterior mean, sd and 95 % interval per parameter), demPropertiesFragment, response.png,
-samples.png, convergence.png.  Run again after an interruption: finished runs are kept, a run
-that was stopped continues from its restart files.  docs/calibration.md has the details.
+Method: a run at the case's own values and a Latin-hypercube first sample, then one
+Gaussian-process surrogate per target and expected improvement of chi2 = sum ((y - value)/sigma)^2.
+It stops when a run agrees with every target within tolerance x sigma and no point promises an
+improvement above eiTolerance (or above what the simulations' fitted scatter alone makes of chi2),
+or at maxRuns (a success if a run agrees, exit 3 if none does).  Output per stage in
+WORKDIR/STAGE/: runs.csv (every finished run), result.json (chosen run, posterior mean, sd and
+95 % interval per parameter), demPropertiesFragment, response.png, samples.png, convergence.png.
+Run again after an interruption: finished runs are kept, a run that was stopped continues from
+its restart files.  docs/calibration.md has the details.
 
 Options:
   -workDir DIR   the work folder (instead of the dictionary's workDir)
@@ -44,7 +45,8 @@ Options:
   -report        write the results and plots from the runs made so far; run nothing
   -stopAfter N   stop once N runs have finished in this call (run again to continue)
 Exit status: 0 done (every stage converged), 1 bad input or a failed run with onFailure stop,
-3 a stage used up maxRuns and no run agrees with its targets (the later stages are not run),
+3 a stage used up maxRuns and no run agrees with its targets, or a check stage does not agree
+(the later stages are not run),
 4 stopped (-stopAfter or a signal) before the end."""
 import os
 import sys
@@ -57,6 +59,7 @@ from diefillcal import config, report, runner  # noqa: E402
 
 def main():
     ap = argument_parser(__doc__)
+    ap.prog = "diefillCalibrate"
     ap.add_argument("dict", nargs="?", default="calibrationDict", help="the calibration dictionary")
     ap.add_argument("-workDir", default=None)
     ap.add_argument("-check", action="store_true")
