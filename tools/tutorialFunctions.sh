@@ -11,6 +11,10 @@
 #                               first run) with the '// @quick ...' lines swapped in (-quick) and
 #                               'rolling <model>' set (-rolling); first checks the case with
 #                               tutorial_guard (VARIANT: "quick|full, rolling MODEL" + EXTRA)
+#   tutorial_lock               one run at a time in the case: locks <case>/.diefill.lock (the lock demRun and
+#                               diefillFoam take) for as long as Allrun runs; a second Allrun (or demRun,
+#                               diefillFoam) in the case stops with exit 2 naming the holder, nothing written.
+#                               The solvers Allrun starts run under its lock (DIEFILL_CASE_LOCK=<file>:<pid>)
 #   tutorial_guard              stops Allrun (exit 2) before it writes anything when the case holds
 #                               results of another variant or of other inputs (a file of tutorial_inputs
 #                               changed, added or removed since the run), or when the generated
@@ -197,9 +201,28 @@ tutorial_record() {
     done <<< "$(tutorial_inputs)"
 }
 
+# The lock is the kernel's (flock): released when this shell ends, however it ends.
+tutorial_lock() {
+    local lock=$PWD/.diefill.lock me
+    me=$(basename "$0")
+    if ! exec {TUTORIAL_LOCK_FD}<>"$lock"; then
+        echo "$me: cannot create the case lock $lock (a case folder must be writable to run in it); nothing done" >&2
+        exit 2
+    fi
+    if ! flock -n "$TUTORIAL_LOCK_FD"; then
+        echo "$me: case $PWD is in use by process $(sed -n 's/^pid //p' "$lock") ($(sed -n 's/^command //p' "$lock"))," \
+             "started $(sed -n 's/^started //p' "$lock") (lock $lock); a second run in it would cut the first one's" \
+             "results; nothing done. Wait for it to end, or run in a copy of the case." >&2
+        exit 2
+    fi
+    printf 'pid %s\ncommand %s\nstarted %s\n' "$$" "$me" "$(date -u '+%Y-%m-%d %H:%M:%S UTC')" > "$lock"
+    export DIEFILL_CASE_LOCK="$lock:$$"
+}
+
 tutorial_prepare() {
     local props=constant/demProperties
     VARIANT=$(tutorial_variant "${1-}")
+    tutorial_lock
     tutorial_guard
     [ -f "$props.orig" ] || cp "$props" "$props.orig"
     tutorial_swap_quick "$props.orig" "$props"

@@ -8,6 +8,7 @@
 #include "vectorIOField.H"
 #include "clockValue.H"
 
+#include "demLib/case_lock.hpp"
 #include "demLib/case_runner.hpp"
 #include "demLib/case_setup.hpp"
 #include "demLib/error.hpp"
@@ -278,6 +279,20 @@ Foam::diefill::demCoupling::demCoupling
 
     // The DEM: the whole case on every rank (see the class description).
     const fileName caseDir = mesh_.time().globalPath();
+    // One run at a time in a case: a second one would write over the first
+    // one's time folders and DEM output.  Taken before anything is written.
+    if (Pstream::master())
+    {
+        try
+        {
+            caseLock_.reset(new dem::CaseLock(caseDir, "diefillFoam"));
+        }
+        catch (const std::exception& e)
+        {
+            FatalErrorInFunction
+                << e.what() << exit(FatalError);
+        }
+    }
     dem::CaseSetup setup;
     try
     {

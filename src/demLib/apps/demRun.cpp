@@ -16,6 +16,7 @@
 #include <omp.h>
 #endif
 
+#include "demLib/case_lock.hpp"
 #include "demLib/case_runner.hpp"
 #include "demLib/command_line.hpp"
 #include "demLib/error.hpp"
@@ -68,7 +69,8 @@ void usage(std::ostream& out) {
            "Writes into the case: log.demRun (a run with -restart adds to it), <output>/particles.xdmf\n"
            "(+ particles_*.h5; open the .xdmf in ParaView), <output>/summary.csv, <output>/restart/restart_*.h5.\n"
            "The input format is described in docs/case-reference.md.  Exit status: 0 on success, 1 on bad\n"
-           "input, 2 on a runtime failure, 128 + the signal when stopped by SIGINT or SIGTERM (the restart\n"
+           "input, 2 on a runtime or filesystem failure or a case in use by another run (the case folder is\n"
+           "locked for the length of a run: <case>/.diefill.lock), 128 + the signal when stopped by SIGINT or SIGTERM (the restart\n"
            "file of that step is written first; a second signal ends it at once).\n";
 }
 
@@ -125,6 +127,7 @@ int main(int argc, char** argv) {
     // The log is opened once the run has started: until then its lines are held here,
     // so that a run refused for its input leaves the log of the earlier run as it was.
     std::ofstream logFile;
+    bool outputsChanged = false;
     const bool continuing = !options.restartFrom.empty();
     std::stringbuf beforeStart;
     TeeBuffer tee(std::cout.rdbuf(), &beforeStart);
@@ -146,6 +149,10 @@ int main(int argc, char** argv) {
             << std::endl;
         dem::CaseSetup setup = dem::readCaseSetup(caseDir);
         if (endTime > 0.0) setup.endTime = endTime;
+        // One run at a time in a case: a second one would cut the first one's results.
+        const dem::CaseLock lock(caseDir, "demRun");
+        dem::requireWritableFile(std::filesystem::path(caseDir) / "log.demRun", "the run's log");
+        options.outputsChanged = &outputsChanged;
         dem::CaseRunner runner(std::move(setup), options, log);
         log.flush();
         openLog();
@@ -169,8 +176,11 @@ int main(int argc, char** argv) {
     } catch (const std::exception& e) {
         const bool inputError = dynamic_cast<const dem::InputError*>(&e) != nullptr;
         log << "\ndemRun: " << (inputError ? "input error: " : "error: ") << e.what() << std::endl;
-        if (!logFile.is_open())
+        if (!outputsChanged)
             log << "demRun: the run did not start; log.demRun and the case's results are as they were" << std::endl;
+        else if (!logFile.is_open())
+            log << "demRun: the run stopped while it opened its output; the results in the case's output folder "
+                   "may be incomplete" << std::endl;
         return inputError ? 1 : 2;
     }
 }

@@ -1,8 +1,13 @@
 #include "demLib/case_runner.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <iomanip>
 #include <sstream>
@@ -10,6 +15,7 @@
 
 #include "demLib/command_line.hpp"
 #include "demLib/error.hpp"
+#include "demLib/hdf5_file.hpp"
 
 namespace dem {
 
@@ -19,6 +25,7 @@ namespace {
 
 std::string formatDuration(double seconds) {
     std::ostringstream s;
+    if (!(seconds < 1e9)) return "> 30 years";  // no overflow of the long below
     const long t = static_cast<long>(std::lround(seconds));
     if (t >= 3600) s << t / 3600 << "h" << std::setw(2) << std::setfill('0') << (t % 3600) / 60 << "m";
     else if (t >= 60) s << t / 60 << "m" << std::setw(2) << std::setfill('0') << t % 60 << "s";
@@ -76,15 +83,18 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
     simulation_ = makeSimulation(setup_);
     wetted_ = !(setup_.wettingTime > 0.0);
     const fs::path out = outputDirectory();
-    fs::create_directories(out / "restart");
 
     const std::string restart =
         options_.restartFrom.empty() ? std::string() : restartFileFor(setup_, options_.restartFrom, "");
     if (!restart.empty()) {
-        simulation_->readRestart(restart);
+        bool checked = false;
+        try {
+            checked = simulation_->readRestart(restart);
+        } catch (const DamagedFileError& e) {
+            throw DamagedFileError(std::string(e.what()) + "; refused: a continued run would not be the run it " +
+                                   "continues. " + intactRestartHint(restart));
+        }
         startTime_ = simulation_->time();
-        log_ << "Continuing from restart file " << restart << " at t = " << startTime_ << " s, step "
-             << simulation_->stepCount() << ", " << simulation_->particles().size() << " particles\n";
         readRunnerState(restart);
         // Wetting happens after the step that reaches wettingTime and before that
         // step's output, so a restart file at or after it holds the water.
@@ -96,7 +106,14 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
             throw InputError("end time " + std::to_string(setup_.endTime) + " s (keyword 'endTime' or -endTime) is " +
                              "before the restart time " + std::to_string(startTime_) +
                              " s; expected an end time after it");
+        // Said once the restart is accepted: a refused one must not first say that it continues.
+        if (!checked)
+            log_ << "Warning: restart file " << restart << " carries no checksums (written before they existed); "
+                 << "read without checking its data\n";
+        log_ << "Continuing from restart file " << restart << " at t = " << startTime_ << " s, step "
+             << simulation_->stepCount() << ", " << simulation_->particles().size() << " particles\n";
     }
+    checkStepCount();
     for (const InsertionSpec& spec : setup_.insertions)
         if (spec.time > setup_.endTime)
             log_ << "Note: " << spec.context << " starts at t = " << spec.time << " s, after the end time "
@@ -108,7 +125,10 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
         performDueInsertions();
         performDueWetting();
     }
+    // Every output must be writable before the first of an earlier run's files changes.
+    requireWritableOutputs(out);
     checkFieldOutputVolume(out);
+    if (options_.outputsChanged) *options_.outputsChanged = true;
     fields_ = std::make_unique<FieldOutput>(out.string(), "particles", restart.empty() ? -1.0 : startTime_);
 
     // The summary keeps the lines up to the restart time and continues after them.
@@ -136,7 +156,7 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
     }
     if (kept.empty()) {
         summary_.open(summaryPath, std::ios::trunc);
-        if (!summary_) throw InputError("cannot write '" + summaryPath.string() + "'");
+        if (!summary_) throw RuntimeError("cannot write '" + summaryPath.string() + "': " + std::strerror(errno));
         summary_ << std::setprecision(10);
         writeSummaryHeader();
     } else {
@@ -148,11 +168,11 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
             std::ofstream rewrite(keptPath, std::ios::trunc);
             for (const std::string& l : kept) rewrite << l << "\n";
             rewrite.flush();
-            if (!rewrite) throw InputError("cannot write '" + keptPath.string() + "'");
+            if (!rewrite) throw RuntimeError("cannot write '" + keptPath.string() + "': " + std::strerror(errno));
         }
         fs::rename(keptPath, summaryPath);
         summary_.open(summaryPath, std::ios::app);
-        if (!summary_) throw InputError("cannot write '" + summaryPath.string() + "'");
+        if (!summary_) throw RuntimeError("cannot write '" + summaryPath.string() + "': " + std::strerror(errno));
         summary_ << std::setprecision(10);
     }
 
@@ -169,6 +189,9 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
 }
 
 void CaseRunner::readRunnerState(const std::string& restartFile) {
+    if (fs::exists(restartFile + ".runner") && !fs::is_regular_file(restartFile + ".runner"))
+        throw InputError("restart file '" + restartFile + "': its companion '" + restartFile +
+                         ".runner' is not a plain file; expected the file written by demRun");
     std::ifstream in(restartFile + ".runner");
     long done = -1, placed = -1;
     if (!(in >> done >> placed >> nextWaveTime_) || done < 0 || placed < 0 || !std::isfinite(nextWaveTime_))
@@ -228,6 +251,14 @@ std::string nameInLatest(const fs::path& restartDir) {
 }
 }  // namespace
 
+// A FIFO or a device would block the reading, or never end it.
+static std::string requireRestartFileIsFile(const std::string& file, const std::string& who) {
+    if (!fs::is_regular_file(file))
+        throw InputError(who + "-restart '" + file + "': not a plain file (a folder, a FIFO or a device); expected a "
+                         "restart file of <output>/restart/");
+    return file;
+}
+
 std::string latestRestartFile(const CaseSetup& setup) {
     const fs::path dir = restartDirectory(setup);
     const std::string name = nameInLatest(dir);
@@ -241,16 +272,31 @@ std::string restartFileFor(const CaseSetup& setup, const std::string& arg, const
     if (arg == "latest") {
         const fs::path dir = restartDirectory(setup);
         const std::string named = nameInLatest(dir);
-        if (named.empty())
-            throw InputError(who + "-restart latest: no restart file found in '" + dir.string() +
-                             "' (run the case first, or give -restart FILE)");
+        if (named.empty()) {
+            // Restart files without the pointer (it was removed, or the run was stopped
+            // before it wrote one): name them instead of saying there are none.
+            std::vector<std::string> files;
+            std::error_code error;
+            for (const fs::directory_entry& e : fs::directory_iterator(dir, error)) {
+                const std::string name = e.path().filename().string();
+                if (name.rfind("restart_", 0) == 0 && e.path().extension() == ".h5") files.push_back(name);
+            }
+            std::sort(files.begin(), files.end());
+            if (files.empty())
+                throw InputError(who + "-restart latest: no restart file found in '" + dir.string() +
+                                 "' (run the case first, or give -restart FILE)");
+            throw InputError(who + "-restart latest: '" + (dir / "latest").string() + "', the pointer to the newest "
+                             "restart file, is missing, but the folder holds " + std::to_string(files.size()) +
+                             " restart file(s), the newest by step '" + (dir / files.back()).string() +
+                             "'; expected the pointer: give the file to continue from as -restart FILE");
+        }
         if (!fs::exists(dir / named))
             throw InputError(who + "-restart latest: '" + (dir / "latest").string() + "' names '" + named +
                              "', which is not there; expected a restart file of that folder (give it as "
                              "-restart FILE)");
-        return (dir / named).string();
+        return requireRestartFileIsFile((dir / named).string(), who);
     }
-    if (fs::exists(arg)) return arg;
+    if (fs::exists(arg)) return requireRestartFileIsFile(arg, who);
     std::string message = who + "-restart '" + arg + "': no such file";
     const fs::path path(arg);
     if (path.is_relative()) {
@@ -259,6 +305,101 @@ std::string restartFileFor(const CaseSetup& setup, const std::string& arg, const
         if (fs::exists(inCase)) message += "; did you mean '" + inCase.string() + "'?";
     }
     throw InputError(message + "; expected a restart file or 'latest' (the newest one of the case)");
+}
+
+void CaseRunner::checkStepCount() const {
+    const double dt = simulation_->timeStep();
+    const double steps = (setup_.endTime - startTime_) / dt;
+    if (!(steps <= maxRunSteps)) {
+        std::ostringstream m;
+        m << std::setprecision(3) << "file '" << setup_.propertiesFile << "', keyword 'simulation/timeStep' = " << dt
+          << " s: the run to t = " << setup_.endTime << " s (endTime or -endTime) would take " << steps
+          << " steps; expected at most " << maxRunSteps << " (at ten million steps a second, more than a day)";
+        throw InputError(m.str());
+    }
+}
+
+std::string CaseRunner::intactRestartHint(const std::string& damaged) const {
+    // The user chooses the fallback: the message names it, nothing is read from it here.
+    const fs::path dir = fs::path(damaged).parent_path();
+    std::vector<fs::path> candidates;
+    std::error_code error;
+    for (const fs::directory_entry& e : fs::directory_iterator(dir.empty() ? fs::path(".") : dir, error)) {
+        const std::string name = e.path().filename().string();
+        if (name.rfind("restart_", 0) == 0 && e.path().extension() == ".h5" && e.is_regular_file() &&
+            !fs::equivalent(e.path(), damaged, error))
+            candidates.push_back(e.path());
+    }
+    std::sort(candidates.rbegin(), candidates.rend());  // newest step first (zero-padded names)
+    for (const fs::path& candidate : candidates) {
+        if (candidate.filename().string() > fs::path(damaged).filename().string()) continue;
+        try {
+            makeSimulation(setup_)->readRestart(candidate.string());
+            if (!fs::is_regular_file(candidate.string() + ".runner")) continue;
+            return "The newest intact restart file before it is '" + candidate.string() +
+                   "': continue from it with -restart " + candidate.string() + ", or start the run afresh";
+        } catch (const std::exception&) {
+        }
+    }
+    return "No intact restart file before it is left in '" + dir.string() + "': start the run afresh";
+}
+
+namespace {
+
+// A folder the run writes into: there, a folder, and a file can be created in it.
+void requireWritableFolder(const fs::path& dir) {
+    const fs::path probe = dir / (".diefill-write-test." + std::to_string(::getpid()));
+    const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+    if (fd < 0)
+        throw RuntimeError("cannot write in the folder '" + dir.string() + "': " + std::strerror(errno));
+    ::close(fd);
+    ::unlink(probe.c_str());
+}
+
+[[noreturn]] void takenName(const fs::path& path, const std::string& what) {
+    throw RuntimeError("cannot write '" + path.string() + "': the name is taken by " +
+                       (fs::is_directory(path) ? "a folder" : "something that is not a plain file") +
+                       "; expected " + what + " there (move it out of the way)");
+}
+
+}  // namespace
+
+void requireWritableFile(const fs::path& file, const std::string& what) {
+    std::error_code error;
+    const fs::file_status status = fs::symlink_status(file, error);
+    if (fs::exists(status)) {
+        if (!fs::is_regular_file(status)) takenName(file, what);
+        // Opened for appending, not created, not cut: the file is as it was.
+        const int fd = ::open(file.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC | O_NONBLOCK);
+        if (fd < 0) throw RuntimeError("cannot write '" + file.string() + "': " + std::strerror(errno));
+        ::close(fd);
+    }
+    requireWritableFolder(file.parent_path().empty() ? fs::path(".") : file.parent_path());
+}
+
+void CaseRunner::requireWritableOutputs(const fs::path& out) const {
+    const fs::path restartDir = out / "restart";
+    for (const fs::path& dir : {out, restartDir}) {
+        std::error_code error;
+        if (fs::exists(fs::symlink_status(dir, error)) && !fs::is_directory(dir)) takenName(dir, "a folder of results");
+    }
+    std::error_code error;
+    fs::create_directories(restartDir, error);
+    if (error)
+        throw RuntimeError("cannot create the output folder '" + restartDir.string() + "': " + error.message());
+    requireWritableFile(out / "summary.csv", "the run's summary.csv");
+    requireWritableFile(out / "particles.xdmf", "the index of the particle files");
+    requireWritableFile(out / "particles.series", "the list of the particle files");
+    requireWritableFile(restartDir / "latest", "the pointer to the newest restart file");
+    // Files of later steps are written under a temporary name and renamed: a folder of that
+    // name would stop the run after it had started.
+    for (const fs::path& dir : {out, restartDir})
+        for (const fs::directory_entry& e : fs::directory_iterator(dir, error)) {
+            const std::string name = e.path().filename().string();
+            const bool ours = (name.rfind("particles_", 0) == 0 || name.rfind("restart_", 0) == 0) &&
+                              name.find(".h5") != std::string::npos;
+            if (ours && !fs::is_regular_file(e.symlink_status())) takenName(e.path(), "a file of results");
+        }
 }
 
 void CaseRunner::checkFieldOutputVolume(const fs::path& out) const {
@@ -475,12 +616,35 @@ void CaseRunner::advanceTo(double time) {
             const double t = static_cast<double>(next) * dt;
             if (!(t < target - 0.5 * dt) || insertionDueAt(t) || wettingDueAt(t) || outputDueAt(t)) break;
         }
+        const std::size_t before = s.particles().size();
         s.step(steps);
+        requireParticlesKept(before);
         performDueInsertions();
         performDueWetting();
         writeDueOutput(false);
         progress(false);
     }
+}
+
+void CaseRunner::requireParticlesKept(std::size_t before) {
+    // Every particle lost in the first interval after the run's first particles (its
+    // first log interval, 100 to 10 000 steps): no bed leaves its domain so soon;
+    // magnitudes that are not physics (a gravity, speed or density near the largest
+    // double) do.  Stopped with an error, not ended as if the run had succeeded.
+    const Simulation& s = *simulation_;
+    if (firstParticlesStep_ < 0 && before > 0) firstParticlesStep_ = s.stepCount();
+    if (before == 0 || s.particles().size() > 0 || firstParticlesStep_ < 0) return;
+    const double interval = setup_.output.logInterval / s.timeStep();
+    const double window = std::clamp(std::isfinite(interval) ? interval : 0.0, 100.0, 10000.0);
+    if (static_cast<double>(s.stepCount() - firstParticlesStep_) > window) return;
+    std::ostringstream m;
+    m << std::setprecision(3) << "file '" << setup_.propertiesFile << "': every particle (" << s.lostCount()
+      << ") was lost by t = " << s.time() << " s, within " << s.stepCount() - firstParticlesStep_
+      << " steps of the first ones (they left the domain, or their state became infinite or NaN); expected "
+         "magnitudes of physics: check the keywords 'simulation/gravity' (|g| = "
+      << setup_.settings.gravity.norm() << " m/s^2), the insertions' 'velocity', the materials' 'density' and "
+         "'youngsModulus', and 'simulation/domain'";
+    throw InputError(m.str());
 }
 
 void CaseRunner::finish() {

@@ -38,6 +38,78 @@ double availableMemoryBytes() {
     throw InputError(d.describe(key) + ": " + expected);
 }
 
+// The results stay in the case folder, apart from its inputs: a directory '..', an
+// absolute one, or one in constant/ or system/ (also through a link) would put particle
+// files beside the case or among its inputs.
+void requireOutputInsideCase(const Dictionary& o, const std::string& caseDir, const std::string& directory) {
+    const fs::path given = fs::path(directory).lexically_normal();
+    const std::string expected = "; expected a folder inside the case for the results, outside constant/ and system/, "
+                                 "e.g. 'dem'";
+    if (given.is_absolute()) invalid(o, "directory", "'" + directory + "' is an absolute path" + expected);
+    const std::string first = given.begin() == given.end() ? std::string() : given.begin()->string();
+    if (first == "..") invalid(o, "directory", "'" + directory + "' leaves the case folder" + expected);
+    if (first == "constant" || first == "system")
+        invalid(o, "directory", "'" + directory + "' lies in " + first + "/, among the case's inputs" + expected);
+    std::error_code error;
+    const fs::path caseReal = fs::weakly_canonical(fs::absolute(caseDir), error);
+    const fs::path outReal = fs::weakly_canonical(fs::absolute(fs::path(caseDir) / given), error);
+    if (error) return;
+    auto within = [](const fs::path& path, const fs::path& folder) {
+        const fs::path relative = path.lexically_relative(folder);
+        return !relative.empty() && *relative.begin() != "..";
+    };
+    if (!within(outReal, caseReal) || outReal == caseReal)
+        invalid(o, "directory", "'" + directory + "' leads (through a link) to '" + outReal.string() +
+                                    "', outside the case folder" + expected);
+    for (const char* inputs : {"constant", "system"})
+        if (within(outReal, fs::weakly_canonical(caseReal / inputs, error)))
+            invalid(o, "directory", "'" + directory + "' leads (through a link) into " + inputs + "/" + expected);
+}
+
+constexpr double maxYoungsModulus = 1e13;  // [Pa]
+constexpr double maxRunSteps = 1e12;       // as CaseRunner::maxRunSteps
+// Far beyond any solid (osmium: 22 590 kg/m^3), still room for tests that pin particles
+// with a huge density (tests/diefillFoam/packedBed: 1e9).
+constexpr double maxDensity = 1e12;  // [kg/m^3]
+
+// Magnitudes whose consequences are absurd (a mass or weight that is not finite, a
+// particle moved more than half its radius in one step by gravity or its insertion
+// speed): the run would lose every particle and end as if it had succeeded.
+void checkMagnitudes(const Dictionary& root, const Dictionary& d, const InsertionSpec& spec, const CaseSetup& setup,
+                     double smallestRadius, double heaviestMass) {
+    const SimulationSettings& s = setup.settings;
+    const Material& material = setup.materials[spec.materialIndex];
+    const Dictionary& materialDict = root.subDict("materials").subDict(material.name);
+    const Dictionary& simulation = root.subDict("simulation");
+    const double dt = s.timeStep;
+    const double g = s.gravity.stableNorm();  // stableNorm: no overflow of the squares
+    const double speed = spec.request.initialVelocity.stableNorm();
+    std::ostringstream m;
+    m << std::setprecision(3);
+    if (!std::isfinite(heaviestMass)) {
+        m << "the heaviest particle of '" << spec.name << "' would have a mass that is not a finite number; "
+          << "expected the density of a solid in kg/m^3, got " << material.density;
+        invalid(materialDict, "density", m.str());
+    }
+    if (!(0.5 * g * dt * dt <= 0.5 * smallestRadius)) {
+        m << "|gravity| = " << g << " m/s^2 moves a particle at rest " << 0.5 * g * dt * dt << " m in one step of "
+          << dt << " s, more than half the smallest radius of '" << spec.name << "' (" << smallestRadius
+          << " m); expected a gravity in m/s^2, e.g. (0 0 -9.81)";
+        invalid(simulation, "gravity", m.str());
+    }
+    if (!std::isfinite(heaviestMass * g)) {
+        m << "the weight of the heaviest particle of '" << spec.name << "' (" << heaviestMass << " kg times "
+          << g << " m/s^2) is not a finite number; expected the density of a solid in kg/m^3, got " << material.density;
+        invalid(materialDict, "density", m.str());
+    }
+    if (!(speed * dt <= 0.5 * smallestRadius) || !std::isfinite(heaviestMass * speed * speed)) {
+        m << "at " << speed << " m/s a particle moves " << speed * dt << " m in one step of " << dt
+          << " s, more than half the smallest radius (" << smallestRadius
+          << " m): its contacts would be missed; expected a speed in m/s below " << 0.5 * smallestRadius / dt;
+        invalid(d, "velocity", m.str());
+    }
+}
+
 // Wall and region names become column names of summary.csv (wallForce_<wall>_x,
 // mass_<region>): a comma or a quote in one would shift every column after it.
 void requireColumnName(const Dictionary& d, const std::string& name, const std::string& what) {
@@ -268,6 +340,8 @@ std::vector<InsertionSpec> readInsertions(const Dictionary& root, const CaseSetu
             if (spec.explicitParticles.empty())
                 invalid(d, "positions", "expected a list of at least one position, e.g. ((0 0 0.01))");
             spec.request.initialVelocity = d.getOrDefault<Vec3>("velocity", Vec3::Zero());
+            const double radius = 0.5 * diameter * setup.coarseGrain.factor;
+            checkMagnitudes(root, d, spec, setup, radius, sphereMass(2.0 * radius, setup.materials[spec.materialIndex].density));
             out.push_back(std::move(spec));
             continue;
         }
@@ -301,6 +375,7 @@ std::vector<InsertionSpec> readInsertions(const Dictionary& root, const CaseSetu
             r.placement.whenFull = WhenRegionFull::PlaceWhatFits;
         }
         checkPopulationSize(d, spec, byMass ? "mass" : "count");
+        checkMagnitudes(root, d, spec, setup, 0.5 * spec.distribution->dMin(), sphereMass(spec.distribution->dMax(), r.density));
         out.push_back(std::move(spec));
     }
     return out;
@@ -318,6 +393,9 @@ CaseSetup readCaseSetup(const std::string& caseDir) {
     const std::string file = (fs::path(caseDir) / "constant" / "demProperties").string();
     if (!fs::exists(file))
         throw InputError("case '" + caseDir + "': missing file constant/demProperties (expected the DEM setup of the case there)");
+    if (!fs::is_regular_file(file))
+        throw InputError("case '" + caseDir + "': constant/demProperties is not a plain file (a folder, a FIFO or a "
+                         "device); expected the DEM setup of the case as a text file");
     return readCaseSetup(Dictionary::fromFile(file), caseDir);
 }
 
@@ -331,6 +409,13 @@ CaseSetup readCaseSetup(const Dictionary& root, const std::string& caseDir) {
     s.source = root.fileName();
     s.timeStep = sim.getPositive("timeStep");
     c.endTime = sim.getPositive("endTime");
+    if (!(c.endTime / s.timeStep <= maxRunSteps)) {
+        std::ostringstream e;
+        e << std::setprecision(3) << "the run to endTime " << c.endTime << " s would take " << c.endTime / s.timeStep
+          << " steps; expected at most " << maxRunSteps
+          << " steps (at ten million steps a second, more than a day): a time step in seconds";
+        invalid(sim, "timeStep", e.str());
+    }
     s.gravity = sim.get<Vec3>("gravity");
     if (sim.has("skinFraction")) s.skinFraction = sim.getInRange("skinFraction", 1e-3, 2.0);
     if (sim.has("maxRayleighFraction")) s.maxRayleighFraction = sim.getInRange("maxRayleighFraction", 1e-3, 1.0);
@@ -400,9 +485,23 @@ CaseSetup readCaseSetup(const Dictionary& root, const std::string& caseDir) {
         const Dictionary& m = mats.subDict(name);
         Material mat;
         mat.name = name;
+        // Beyond any solid (diamond: 1.2e12 Pa) is a typo, not a stiff material; refused here
+        // rather than by the time-step limit that it would shrink to nothing.
         mat.youngsModulus = m.getPositive("youngsModulus");
+        if (mat.youngsModulus > maxYoungsModulus) {
+            std::ostringstream e;
+            e << "expected a Young's modulus of a solid, at most " << maxYoungsModulus
+              << " Pa (diamond: 1.2e12 Pa), got " << mat.youngsModulus << " Pa";
+            invalid(m, "youngsModulus", e.str());
+        }
         mat.poissonRatio = m.getInRange("poissonRatio", 0.0, 0.5);
         mat.density = m.getPositive("density");
+        if (mat.density > maxDensity) {
+            std::ostringstream e;
+            e << "expected a density in kg/m^3, at most " << maxDensity << " (the densest solid, osmium, has 22 590), got "
+              << mat.density;
+            invalid(m, "density", e.str());
+        }
         c.materials.push_back(mat);
     }
     if (c.materials.empty()) invalid(root, "materials", "expected at least one material");
@@ -449,6 +548,7 @@ CaseSetup readCaseSetup(const Dictionary& root, const std::string& caseDir) {
         if (c.output.directory.find_first_not_of(" \t") == std::string::npos ||
             fs::equivalent(outDir, caseDir, sameError))
             invalid(o, "directory", "expected a folder for the results apart from the case folder itself, e.g. 'dem'");
+        requireOutputInsideCase(o, caseDir, c.output.directory);
         if (fs::exists(outDir) && !fs::is_directory(outDir))
             invalid(o, "directory", "'" + outDir.string() + "' is a file; expected a folder for the results");
         c.output.fieldInterval = o.has("fieldInterval") ? o.getNonNegative("fieldInterval") : 0.0;

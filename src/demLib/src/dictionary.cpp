@@ -184,8 +184,11 @@ std::vector<Token> tokenize(const std::string& text, const std::string& file) {
 }
 
 std::string readFile(const std::string& path, bool& ok) {
+    // Checked before opening: opening a FIFO waits for a writer, reading a device never ends.
+    ok = std::filesystem::is_regular_file(path);
+    if (!ok) return "";
     std::ifstream in(path, std::ios::binary);
-    ok = in.good() && std::filesystem::is_regular_file(path);
+    ok = in.good();
     if (!ok) return "";
     std::ostringstream buffer;
     buffer << in.rdbuf();

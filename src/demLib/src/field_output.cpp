@@ -33,7 +33,7 @@ FieldOutput::FieldOutput(std::string directory, std::string baseName, double con
     : directory_(std::move(directory)), baseName_(std::move(baseName)) {
     std::error_code ec;
     fs::create_directories(directory_, ec);
-    if (ec) throw InputError("cannot create output directory '" + directory_ + "': " + ec.message());
+    if (ec) throw RuntimeError("cannot create output directory '" + directory_ + "': " + ec.message());
     indexPath_ = (fs::path(directory_) / (baseName_ + ".xdmf")).string();
     seriesPath_ = (fs::path(directory_) / (baseName_ + ".series")).string();
     std::ifstream in(seriesPath_);
@@ -52,6 +52,7 @@ std::string FieldOutput::write(const Simulation& sim) {
         Hdf5File f(path + ".writing", Hdf5File::Mode::Create);
         f.setAttribute("time", sim.time());
         f.setAttribute("step", static_cast<std::int64_t>(sim.stepCount()));
+        f.sealAttributes();
         f.write("id", p.id);
         f.write("position", p.position);
         f.write("velocity", p.velocity);

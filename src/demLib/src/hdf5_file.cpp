@@ -2,6 +2,7 @@
 
 #include <hdf5.h>
 
+#include "demLib/checksum.hpp"
 #include "demLib/error.hpp"
 
 namespace dem {
@@ -20,6 +21,9 @@ struct Handle {
     throw RuntimeError("HDF5 file '" + path + "': " + what);
 }
 
+constexpr const char* checksumAttribute = "checksum";
+
+// Every dataset carries the checksum of its data (demLib/checksum.hpp), checked when it is read.
 template <class T>
 void writeDataset(hid_t file, const std::string& path, const std::string& name, hid_t type, const T* data,
                   std::size_t rows, std::size_t columns) {
@@ -29,11 +33,17 @@ void writeDataset(hid_t file, const std::string& path, const std::string& name, 
     if (set.id < 0) fail(path, "cannot create dataset '" + name + "'");
     if (rows > 0 && H5Dwrite(set.id, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0)
         fail(path, "cannot write dataset '" + name + "'");
+    const std::uint64_t sum = rows > 0 ? datasetChecksum(data, rows, columns * sizeof(T)) : 0;
+    Handle scalar{H5Screate(H5S_SCALAR), H5Sclose};
+    Handle attr{H5Acreate2(set.id, checksumAttribute, H5T_NATIVE_UINT64, scalar.id, H5P_DEFAULT, H5P_DEFAULT),
+                H5Aclose};
+    if (attr.id < 0 || H5Awrite(attr.id, H5T_NATIVE_UINT64, &sum) < 0)
+        fail(path, "cannot write the checksum of dataset '" + name + "'");
 }
 
 template <class T>
 std::vector<T> readDataset(hid_t file, const std::string& path, const std::string& name, hid_t type,
-                           std::size_t* columns) {
+                           std::size_t* columns, std::size_t& unchecked) {
     Handle set{H5Dopen2(file, name.c_str(), H5P_DEFAULT), H5Dclose};
     if (set.id < 0) fail(path, "missing dataset '" + name + "'");
     Handle space{H5Dget_space(set.id), H5Sclose};
@@ -45,6 +55,19 @@ std::vector<T> readDataset(hid_t file, const std::string& path, const std::strin
     if (!out.empty() && H5Dread(set.id, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()) < 0)
         fail(path, "cannot read dataset '" + name + "'");
     if (columns) *columns = dims[1];
+    if (H5Aexists(set.id, checksumAttribute) > 0) {
+        std::uint64_t stored = 0;
+        Handle attr{H5Aopen(set.id, checksumAttribute, H5P_DEFAULT), H5Aclose};
+        if (attr.id < 0 || H5Aread(attr.id, H5T_NATIVE_UINT64, &stored) < 0)
+            throw DamagedFileError("HDF5 file '" + path + "' is damaged: the checksum of dataset '" + name +
+                                   "' cannot be read");
+        const std::uint64_t computed = out.empty() ? 0 : datasetChecksum(out.data(), dims[0], dims[1] * sizeof(T));
+        if (computed != stored)
+            throw DamagedFileError("HDF5 file '" + path + "' is damaged: the data of dataset '" + name +
+                                   "' do not match their checksum (changed since they were written)");
+    } else {
+        ++unchecked;  // written before datasets carried checksums
+    }
     return out;
 }
 
@@ -56,9 +79,10 @@ Hdf5File::Hdf5File(const std::string& path, Mode mode) : path_(path) {
         file_ = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
     else
         file_ = H5Fopen(path.c_str(), mode == Mode::Update ? H5F_ACC_RDWR : H5F_ACC_RDONLY, H5P_DEFAULT);
-    if (file_ < 0)
-        throw InputError("HDF5 file '" + path + "': cannot " +
-                         std::string(mode == Mode::Create ? "create it" : "open it (missing or not HDF5)"));
+    // Creating is the filesystem's business (a folder not writable, a name taken by a
+    // folder); opening a file that is there but not HDF5 is the input's.
+    if (file_ < 0 && mode == Mode::Create) throw RuntimeError("HDF5 file '" + path + "': cannot create it");
+    if (file_ < 0) throw InputError("HDF5 file '" + path + "': cannot open it (missing or not HDF5)");
 }
 
 Hdf5File::~Hdf5File() {
@@ -92,13 +116,13 @@ void Hdf5File::write(const std::string& name, const std::vector<Vec3>& data) {
 }
 
 std::vector<double> Hdf5File::readDoubles(const std::string& name, std::size_t* columns) const {
-    return readDataset<double>(file_, path_, name, H5T_NATIVE_DOUBLE, columns);
+    return readDataset<double>(file_, path_, name, H5T_NATIVE_DOUBLE, columns, unchecked_);
 }
 std::vector<std::int64_t> Hdf5File::readInt64(const std::string& name) const {
-    return readDataset<std::int64_t>(file_, path_, name, H5T_NATIVE_INT64, nullptr);
+    return readDataset<std::int64_t>(file_, path_, name, H5T_NATIVE_INT64, nullptr, unchecked_);
 }
 std::vector<int> Hdf5File::readInts(const std::string& name) const {
-    return readDataset<int>(file_, path_, name, H5T_NATIVE_INT, nullptr);
+    return readDataset<int>(file_, path_, name, H5T_NATIVE_INT, nullptr, unchecked_);
 }
 std::vector<Vec3> Hdf5File::readVec3(const std::string& name) const {
     std::size_t columns = 0;
@@ -144,6 +168,49 @@ std::int64_t Hdf5File::intAttribute(const std::string& name) const {
     return v;
 }
 bool Hdf5File::hasAttribute(const std::string& name) const { return H5Aexists(file_, name.c_str()) > 0; }
+
+namespace {
+constexpr const char* attributeChecksumName = "attributeChecksum";
+
+// Sum over the root group's attributes (but the checksum itself) of the checksum of
+// name, a zero byte and the stored value's bytes: independent of their order.
+herr_t addAttributeChecksum(hid_t location, const char* name, const H5A_info_t*, void* sum) {
+    if (std::string(name) == attributeChecksumName) return 0;
+    Handle attr{H5Aopen(location, name, H5P_DEFAULT), H5Aclose};
+    Handle type{H5Aget_type(attr.id), H5Tclose};
+    Handle space{H5Aget_space(attr.id), H5Sclose};
+    if (attr.id < 0 || type.id < 0 || space.id < 0) return -1;
+    const std::size_t valueBytes = H5Tget_size(type.id) * static_cast<std::size_t>(H5Sget_simple_extent_npoints(space.id));
+    std::vector<unsigned char> bytes(name, name + std::char_traits<char>::length(name) + 1);
+    bytes.resize(bytes.size() + valueBytes);
+    if (H5Aread(attr.id, type.id, bytes.data() + bytes.size() - valueBytes) < 0) return -1;
+    *static_cast<std::uint64_t*>(sum) += datasetChecksum(bytes.data(), 1, bytes.size());
+    return 0;
+}
+
+std::uint64_t attributesChecksum(hid_t file, const std::string& path) {
+    std::uint64_t sum = 0;
+    hsize_t index = 0;
+    if (H5Aiterate2(file, H5_INDEX_NAME, H5_ITER_INC, &index, addAttributeChecksum, &sum) < 0)
+        throw DamagedFileError("HDF5 file '" + path + "' is damaged: its attributes cannot be read");
+    return sum;
+}
+}  // namespace
+
+void Hdf5File::sealAttributes() {
+    const std::uint64_t sum = attributesChecksum(file_, path_);
+    writeAttribute(file_, path_, attributeChecksumName, H5T_NATIVE_UINT64, &sum);
+}
+
+bool Hdf5File::checkAttributes() const {
+    if (!hasAttribute(attributeChecksumName)) return false;
+    std::uint64_t stored = 0;
+    readAttribute(file_, path_, attributeChecksumName, H5T_NATIVE_UINT64, &stored);
+    if (attributesChecksum(file_, path_) != stored)
+        throw DamagedFileError("HDF5 file '" + path_ + "' is damaged: its attributes (time, step, ...) do not match "
+                               "their checksum (changed since they were written)");
+    return true;
+}
 std::string Hdf5File::stringAttribute(const std::string& name) const {
     Handle attr{H5Aopen(file_, name.c_str(), H5P_DEFAULT), H5Aclose};
     if (attr.id < 0) fail(path_, "missing attribute '" + name + "'");

@@ -66,6 +66,7 @@ void Simulation::writeRestart(const std::string& path) const {
         f.setAttribute("listSkin", pairs_.skin());
         f.setAttribute("listExtraRange", pairs_.extraRange());
         f.setAttribute("listBuildCount", static_cast<std::int64_t>(pairs_.buildCount()));
+        f.sealAttributes();  // every dataset below carries its own checksum
 
         const ParticleStore& p = particles_;
         f.createGroup("particles");
@@ -128,9 +129,11 @@ void Simulation::writeRestart(const std::string& path) const {
         throw RuntimeError("cannot rename restart file '" + tmp + "' to '" + path + "'");
 }
 
-void Simulation::readRestart(const std::string& path) {
+bool Simulation::readRestart(const std::string& path) {
     requireNoDecomposition("readRestart");
     Hdf5File f(path, Hdf5File::Mode::Read);
+    // A damaged file is refused before any of it is believed (its format, its counts).
+    const bool sealed = f.checkAttributes();
     if (!f.hasAttribute("format"))
         throw InputError("'" + path + "' is not a restart file (an HDF5 file without the attribute 'format'" +
                          (f.hasAttribute("step") ? ": a particle output file?" : "") +
@@ -257,6 +260,7 @@ void Simulation::readRestart(const std::string& path) {
     rebuildWallCandidates();
     // A case written before a limit was added (or tightened) is not continued beyond it.
     requireAllowedTimeStep("restart file '" + path + "'");
+    return sealed && f.uncheckedDatasets() == 0;
 }
 
 }  // namespace dem

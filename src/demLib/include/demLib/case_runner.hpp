@@ -21,7 +21,14 @@ struct RunOptions {
     std::string restartFrom;
     // Seconds of wall time between progress lines (0: none).
     double progressInterval = 5.0;
+    // Set to true just before the run changes its first output file (until then a run
+    // that stops has left an earlier run's results as they were).
+    bool* outputsChanged = nullptr;
 };
+
+// Throws RuntimeError (a filesystem failure, not an input error) when `file` cannot be
+// written: its name taken by a folder, the file or its folder not writable.  Changes nothing.
+void requireWritableFile(const std::filesystem::path& file, const std::string& what);
 
 // The newest restart file of a case (<case>/<output>/restart/latest names it),
 // or an empty string when there is none.
@@ -65,6 +72,15 @@ private:
     void writeSummaryLine();
     void writeRestart();
     void readRunnerState(const std::string& restartFile);
+    // Most steps a run may take: more is a mistyped time step, whose ETA would overflow.
+    static constexpr double maxRunSteps = 1e12;
+    void checkStepCount() const;  // throws InputError beyond maxRunSteps
+    // Throws InputError when the `before` particles of the last slice were all lost in it.
+    void requireParticlesKept(std::size_t before);
+    // The message's end for a damaged restart file: the newest intact one before it.
+    std::string intactRestartHint(const std::string& damaged) const;
+    // Throws RuntimeError before anything is written when an output cannot be.
+    void requireWritableOutputs(const std::filesystem::path& outputDirectory) const;
     // Throws InputError when the particle files asked for would not fit on the disk.
     void checkFieldOutputVolume(const std::filesystem::path& outputDirectory) const;
     void progress(bool force);
@@ -87,6 +103,7 @@ private:
     double startTime_ = 0.0;
     std::chrono::steady_clock::time_point wallStart_, lastProgress_;
     long stepsAtStart_ = 0;
+    long firstParticlesStep_ = -1;  // the step at which this run first held particles
     ProgressEstimate estimate_{0.0, 0.0};  // the ETA, from the pace of the last minutes
 };
 

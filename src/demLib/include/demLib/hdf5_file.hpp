@@ -5,9 +5,16 @@
 #include <string>
 #include <vector>
 
+#include "demLib/error.hpp"
 #include "demLib/vec3.hpp"
 
 namespace dem {
+
+// A file whose data changed after they were written (a dataset's checksum does not match).
+class DamagedFileError : public InputError {
+public:
+    using InputError::InputError;
+};
 
 class Hdf5File {
 public:
@@ -44,9 +51,18 @@ public:
     std::string stringAttribute(const std::string& name) const;
     bool hasAttribute(const std::string& name) const;
 
+    // Datasets read so far that carry no checksum (files written before checksums
+    // existed); a dataset whose data do not match its checksum throws DamagedFileError.
+    std::size_t uncheckedDatasets() const { return unchecked_; }
+    // Writes the checksum of the root group's attributes (call after the last setAttribute).
+    void sealAttributes();
+    // False when the file has no such checksum; throws DamagedFileError when it does not match.
+    bool checkAttributes() const;
+
 private:
     std::string path_;
     std::int64_t file_ = -1;  // hid_t
+    mutable std::size_t unchecked_ = 0;
 };
 
 }  // namespace dem

@@ -163,9 +163,11 @@ public:
     // readRestart() call it.
     void requireAllowedTimeStep(const std::string& context) const;
 
-    // Restart: the whole state, contact history included.
+    // Restart: the whole state, contact history included.  The file's attributes and
+    // each dataset carry checksums; readRestart throws DamagedFileError when one does not
+    // match, and returns false for a file written before checksums (read unchecked).
     void writeRestart(const std::string& path) const;
-    void readRestart(const std::string& path);
+    bool readRestart(const std::string& path);
 
 private:
     // Removes particles outside the domain box (or not finite); knownNoneLost:
