@@ -548,9 +548,9 @@ CaseSetup readCaseSetup(const Dictionary& root, const std::string& caseDir) {
         if (c.output.directory.find_first_not_of(" \t") == std::string::npos ||
             fs::equivalent(outDir, caseDir, sameError))
             invalid(o, "directory", "expected a folder for the results apart from the case folder itself, e.g. 'dem'");
-        requireOutputInsideCase(o, caseDir, c.output.directory);
         if (fs::exists(outDir) && !fs::is_directory(outDir))
             invalid(o, "directory", "'" + outDir.string() + "' is a file; expected a folder for the results");
+        requireOutputInsideCase(o, caseDir, c.output.directory);
         c.output.fieldInterval = o.has("fieldInterval") ? o.getNonNegative("fieldInterval") : 0.0;
         c.output.logInterval = o.has("logInterval") ? o.getNonNegative("logInterval") : 0.0;
         c.output.restartInterval = o.has("restartInterval") ? o.getNonNegative("restartInterval") : 0.0;
