@@ -222,8 +222,8 @@ tutorial_lock() {
 tutorial_prepare() {
     local props=constant/demProperties
     VARIANT=$(tutorial_variant "${1-}")
+    tutorial_guard     # reads only: a run it refuses leaves even the lock file as it was
     tutorial_lock
-    tutorial_guard
     [ -f "$props.orig" ] || cp "$props" "$props.orig"
     tutorial_swap_quick "$props.orig" "$props"
     if [ -n "$ROLLING" ]; then
