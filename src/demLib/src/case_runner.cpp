@@ -15,7 +15,6 @@
 
 #include "demLib/command_line.hpp"
 #include "demLib/error.hpp"
-#include "demLib/hdf5_file.hpp"
 
 namespace dem {
 

@@ -12,6 +12,13 @@ public:
     using std::runtime_error::runtime_error;
 };
 
+// A file whose data changed after they were written (an HDF5 dataset's or attributes'
+// checksum does not match): refused as input, naming the file.
+class DamagedFileError : public InputError {
+public:
+    using InputError::InputError;
+};
+
 // A state the engine cannot continue from (NaN, lost contact with reality).
 class RuntimeError : public std::runtime_error {
 public:

@@ -10,12 +10,6 @@
 
 namespace dem {
 
-// A file whose data changed after they were written (a dataset's checksum does not match).
-class DamagedFileError : public InputError {
-public:
-    using InputError::InputError;
-};
-
 class Hdf5File {
 public:
     // Create (or truncate), Read only, or Update (an existing file, read and write).
