@@ -243,15 +243,24 @@ tutorial_timed_run() {
     "$@" || status=$?
     TUTORIAL_DEM_SECONDS=$((SECONDS - start))
     if [ "$status" -ne 0 ]; then
-        echo "$(basename "$PWD"): $name failed (exit $status); last lines of $log:" >&2
-        tail -n 30 "$log" >&2
+        # A run refused before it started (a locked case, a damaged restart file) has not
+        # written its log: its console output says why.
+        if [ -s "${TUTORIAL_CONSOLE-}" ] && ! grep -qF -- "$(tail -n 1 "$TUTORIAL_CONSOLE")" "$log" 2> /dev/null; then
+            echo "$(basename "$PWD"): $name failed (exit $status):" >&2
+            tail -n 30 "$TUTORIAL_CONSOLE" >&2
+        else
+            echo "$(basename "$PWD"): $name failed (exit $status); last lines of $log:" >&2
+            tail -n 30 "$log" >&2
+        fi
+        rm -f "${TUTORIAL_CONSOLE-}"
         exit "$status"
     fi
+    rm -f "${TUTORIAL_CONSOLE-}"
     echo "    $name: ok (${TUTORIAL_DEM_SECONDS} s, $log)"
 }
 
 # demRun writes log.demRun itself (with its progress lines and ETA)
-_tutorial_demRun() { "${DEMRUN:-demRun}" -case "$PWD" -threads "$THREADS" ${TUTORIAL_RESTART_ARGS[@]+"${TUTORIAL_RESTART_ARGS[@]}"} > /dev/null 2>&1; }
+_tutorial_demRun() { "${DEMRUN:-demRun}" -case "$PWD" -threads "$THREADS" ${TUTORIAL_RESTART_ARGS[@]+"${TUTORIAL_RESTART_ARGS[@]}"} > "$TUTORIAL_CONSOLE" 2>&1; }
 _tutorial_diefillFoam() { diefillFoam >> log.diefillFoam 2>&1; }
 
 # A stopped run (or a finished one: then only the post-processing runs again) goes on from its
@@ -265,6 +274,7 @@ tutorial_run_demRun() {
         rm -rf dem log.demRun
     fi
     tutorial_record
+    TUTORIAL_CONSOLE=$(mktemp)      # outside the case: the console output, shown if demRun is refused
     tutorial_timed_run demRun log.demRun _tutorial_demRun
     TUTORIAL_RUNTIME_ARGS=()
     [ -n "${TUTORIAL_RESTART_ARGS[*]}" ] || TUTORIAL_RUNTIME_ARGS=(-runTime "$TUTORIAL_DEM_SECONDS")
