@@ -77,9 +77,7 @@ def half_masses(position, mass, radius):
 
 
 def value_at(t, values, when):
-    """The column's value on the summary line nearest to time `when` (None if it has none)."""
-    if values is None or len(t) == 0:
-        return None
+    """The column's value on the summary line nearest to time `when`."""
     return float(values[int(np.argmin(np.abs(np.asarray(t) - when)))])
 
 
