@@ -108,13 +108,74 @@ bool wallKeyLess(const GhostExchange::WallRecord& a, const GhostExchange::WallRe
 
 }  // namespace
 
-GhostExchange::GhostExchange(Communicator communicator, SlabDecomposition slabs)
+GhostExchange::GhostExchange(Communicator communicator, SlabDecomposition slabs, double rebalanceThreshold)
     : communicator_(std::move(communicator)), slabs_(std::move(slabs)) {
     if (slabs_.ranks() != communicator_.size())
         throw InputError("demLib domain decomposition: " + std::to_string(slabs_.ranks()) + " slabs for " +
                          std::to_string(communicator_.size()) + " ranks; expected one slab per rank");
+    setRebalanceThreshold(rebalanceThreshold);
     sendList_.assign(communicator_.size(), {});
     receiveCount_.assign(communicator_.size(), 0);
+}
+
+void GhostExchange::setSlabs(SlabDecomposition slabs) {
+    if (ghostCount_ != 0) throw RuntimeError("demLib ghost exchange: setSlabs() called with ghosts present");
+    if (slabs.ranks() != communicator_.size())
+        throw InputError("demLib domain decomposition: " + std::to_string(slabs.ranks()) + " slabs for " +
+                         std::to_string(communicator_.size()) + " ranks; expected one slab per rank");
+    slabs_ = std::move(slabs);
+}
+
+void GhostExchange::setRebalanceThreshold(double threshold) {
+    if (!(threshold == 0.0 || threshold >= 1.0))  // NaN fails too
+        throw InputError("demLib domain decomposition: rebalance threshold " + std::to_string(threshold) +
+                         "; expected max/mean owned >= 1 to re-cut at, or 0 (or infinity) for no balancing");
+    rebalanceThreshold_ = threshold;
+}
+
+GhostExchange::RebalanceReport GhostExchange::rebalanceIfNeeded(const ParticleStore& p,
+                                                                const std::vector<double>& weights) {
+    if (ghostCount_ != 0) throw RuntimeError("demLib ghost exchange: rebalanceIfNeeded() called with ghosts present");
+    RebalanceReport report;
+    if (!balancingEnabled()) {
+        report.cuts = slabs_.interiorCuts();
+        lastRebalance_ = report;
+        return report;
+    }
+    const std::size_t owned = p.size();
+    if (!weights.empty() && weights.size() != owned)
+        throw InputError("demLib ghost exchange: " + std::to_string(weights.size()) + " load weights for " +
+                         std::to_string(owned) + " owned particles; expected one each (or none)");
+    const int ranks = communicator_.size();
+    // Integer sum and max: exact, so every rank takes the same decision.
+    const std::int64_t total = communicator_.sum(static_cast<std::int64_t>(owned));
+    report.maxOwned = static_cast<std::int64_t>(communicator_.max(static_cast<double>(owned)));
+    report.meanOwned = static_cast<double>(total) / ranks;
+    bool recut = false;
+    if (weights.empty()) {
+        report.imbalance = total > 0 ? report.maxOwned / report.meanOwned : 0.0;
+        recut = total > 0 && report.imbalance > rebalanceThreshold_;
+    } else {
+        double load = 0.0;
+        for (double w : weights) load += w;
+        const double maxLoad = communicator_.max(load);
+        const double meanLoad = communicator_.sum(load) / ranks;
+        report.imbalance = meanLoad > 0.0 ? maxLoad / meanLoad : 0.0;
+        // A floating-point sum may differ by a rounding between ranks: one
+        // vote decides for all.
+        recut = communicator_.anyTrue(meanLoad > 0.0 && report.imbalance > rebalanceThreshold_);
+    }
+    if (recut) {
+        const int axis = slabs_.axis();
+        std::vector<double> coordinates(owned);
+        for (std::size_t i = 0; i < owned; ++i) coordinates[i] = p.position[i][axis];
+        setSlabs(SlabDecomposition::balanced(communicator_, axis, coordinates, weights));
+        ++recuts_;
+    }
+    report.recut = recut;
+    report.cuts = slabs_.interiorCuts();
+    lastRebalance_ = report;
+    return report;
 }
 
 void GhostExchange::dropGhosts(ParticleStore& p, ParticleParticleNeighborList& pairs, ParticleWallContacts& walls) {

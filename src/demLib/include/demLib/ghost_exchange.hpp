@@ -31,8 +31,13 @@ namespace dem {
 
 class GhostExchange {
 public:
-    // The slabs must have one slab per rank of the communicator (InputError otherwise).
-    GhostExchange(Communicator communicator, SlabDecomposition slabs);
+    // max/mean owned beyond which rebalanceIfNeeded re-cuts the slabs.
+    static constexpr double defaultRebalanceThreshold = 1.10;
+
+    // The slabs must have one slab per rank of the communicator (InputError
+    // otherwise).  rebalanceThreshold: see setRebalanceThreshold.
+    GhostExchange(Communicator communicator, SlabDecomposition slabs,
+                  double rebalanceThreshold = defaultRebalanceThreshold);
 
     const Communicator& communicator() const { return communicator_; }
     const SlabDecomposition& slabs() const { return slabs_; }
@@ -81,6 +86,42 @@ public:
         double bridgeVolume;
     };
     std::size_t stashedPairs() const { return pairStash_.size(); }
+
+    // Replaces the slabs (same rank count; the axis may change).  Requires no
+    // ghosts; the next migrate() moves the particles.  Local: every rank must
+    // be given the same slabs.
+    void setSlabs(SlabDecomposition slabs);
+
+    // What one rebalanceIfNeeded call found and did.
+    struct RebalanceReport {
+        bool recut = false;
+        // Before any re-cut: the largest and the mean owned count over the
+        // ranks, and max/mean of the balanced load (the counts, or the summed
+        // weights when weights were given).  Zeros when balancing is disabled.
+        std::int64_t maxOwned = 0;
+        double meanOwned = 0.0;
+        double imbalance = 0.0;
+        std::vector<double> cuts;  // interior cuts after the call
+    };
+    // A threshold t >= 1: re-cut when max/mean load > t.  0 or +infinity
+    // disables balancing (rebalanceIfNeeded then does no collective; all ranks
+    // must hold the same setting).  Anything else throws InputError.
+    void setRebalanceThreshold(double threshold);
+    double rebalanceThreshold() const { return rebalanceThreshold_; }
+    bool balancingEnabled() const { return rebalanceThreshold_ > 0.0 && rebalanceThreshold_ < 1e300; }
+
+    // With no ghosts present (after dropGhosts, before migrate): the owned
+    // counts (or summed `weights`, one per owned particle, e.g. contact
+    // counts) of all ranks; if max/mean exceeds the threshold, new cuts along
+    // the same axis from the owned positions (SlabDecomposition::balanced:
+    // max/mean owned <= 1.01 + 2/mean after the migrate that must follow).
+    // Costs two reductions when no re-cut is needed (five with weights); a
+    // re-cut adds a few rounds of small exchanges, bounded by the rank count.
+    // Collective.
+    RebalanceReport rebalanceIfNeeded(const ParticleStore& particles, const std::vector<double>& weights = {});
+    // Re-cuts so far, and the report of the latest rebalanceIfNeeded call.
+    std::size_t recutCount() const { return recuts_; }
+    const RebalanceReport& lastRebalance() const { return lastRebalance_; }
     // Particles this rank has sent to other ranks by migrate() so far.
     std::size_t migratedCount() const { return migrated_; }
 
@@ -93,6 +134,9 @@ private:
     std::vector<std::size_t> receiveCount_;   // per rank: ghosts received from it
     std::vector<PairRecord> pairStash_;
     std::vector<WallRecord> wallStash_;
+    double rebalanceThreshold_ = defaultRebalanceThreshold;
+    std::size_t recuts_ = 0;
+    RebalanceReport lastRebalance_;
 };
 
 }  // namespace dem
