@@ -30,6 +30,7 @@ struct Case {
     double shear = 0.0;  // plus +-shear along x, alternating with the lattice layer in z
     double spacing = 0.0;
     double xLower = 0.0, xUpper = 0.0;  // span of the centres along x
+    double waterContent = 0.0;          // > 0: capillary liquid added after insertion
 
     dem::Simulation make() const { return dem::Simulation(settings, materials, table, walls); }
 };
@@ -105,6 +106,18 @@ inline Case agitatedGas() {
     box.min = Vec3(-1, -1, -1);
     box.max = Vec3(1, 1, 5 * 2.3e-3 + 1.5e-3);
     c.settings.domain = box;
+    return c;
+}
+
+// The agitated gas made wet: capillary bridges (paper's rule, the liquid
+// shared over all bridges of the run) between most neighbours, wall bridges
+// on the floor and sides, bridges breaking and forming as the layers shear,
+// and particles (with their bridges) lost through the open top.
+inline Case wetGas() {
+    Case c = agitatedGas();
+    c.settings.forces.cohesion = dem::CohesionModel::Capillary;
+    c.settings.forces.wallBridges = true;
+    c.waterContent = 0.02;
     return c;
 }
 

@@ -67,6 +67,10 @@ inline std::unique_ptr<Runs> start(const dem::Communicator& comm, const Case& c,
     runs->decomposed.setDecomposition(exchange);
     runs->decomposed.insert(c.particles, 0, Vec3::Zero());
     setMotionById(runs->decomposed, c);
+    if (c.waterContent > 0.0) {
+        runs->serial.setWaterContent(c.waterContent);
+        runs->decomposed.setWaterContent(c.waterContent);
+    }
     return runs;
 }
 
@@ -237,6 +241,84 @@ inline void multiStepRunFollowsTheSerialRun(const dem::Communicator& comm) {
                     "ended in another slab, %zu lost, %ld list builds\n",
                     xError, vError, static_cast<long>(migrations), static_cast<long>(crossed),
                     runs->serial.lostCount(), runs->decomposed.pairList().buildCount());
+}
+
+// Bridges of an owned particle with a ghost (across a slab face) that hold liquid.
+inline std::size_t straddlingBridges(const dem::Simulation& sim) {
+    const auto& offsets = sim.pairList().offsets();
+    const auto& neighbors = sim.pairList().neighbors();
+    const auto& bridge = sim.pairList().bridgeVolume();
+    const std::size_t owned = sim.ownedCount();
+    std::size_t count = 0;
+    for (std::size_t i = 0; i < owned; ++i)
+        for (int k = offsets[i]; k < offsets[i + 1]; ++k)
+            if (static_cast<std::size_t>(neighbors[k]) >= owned && bridge[k] > 0.0) ++count;
+    return count;
+}
+
+// A wet granular gas: the water of the whole run is shared over the bridges
+// of all ranks by the paper's rule, so the decomposed run has the serial
+// run's bridges (count, liquid per weight, hence forces) at every list build,
+// conserves the liquid to 1e-12 summed over ranks, and follows the serial
+// trajectories through rebuilds, migrations, broken bridges and losses.
+inline void wetRunSharesTheSerialLiquid(const dem::Communicator& comm) {
+    const Case c = wetGas();
+    const auto runs = start(comm, c, 0.3);
+    runs->serial.step(1);
+    runs->decomposed.step(1);
+    const double total = runs->serial.liquid().totalVolume;
+    EXPECT_GT(total, 0.0);
+    // The same water on every rank (the dry mass summed over ranks: to rounding).
+    EXPECT_NEAR(runs->decomposed.liquid().totalVolume, total, 1e-14 * total);
+    EXPECT_EQ(comm.max(runs->decomposed.liquid().totalVolume), comm.min(runs->decomposed.liquid().totalVolume));
+    const dem::LiquidState serial = runs->serial.liquid();
+    const dem::LiquidState mine = runs->decomposed.liquidOverRanks();
+    EXPECT_GT(serial.bridgeCount, 300u);
+    EXPECT_GT(serial.wallBridgeCount, 10u);
+    EXPECT_EQ(mine.bridgeCount, serial.bridgeCount);
+    EXPECT_EQ(mine.wallBridgeCount, serial.wallBridgeCount);
+    EXPECT_NEAR(runs->decomposed.liquidInBridges(), total, 1e-12 * total);
+    const std::int64_t straddling = comm.sum(static_cast<std::int64_t>(straddlingBridges(runs->decomposed)));
+    if (comm.size() > 1) {
+        EXPECT_GT(straddling, 20) << "bridges across slab faces";
+    }
+    expectLoadsMatch(comm, *runs, "wet, after 1 step");
+
+    const long steps = 400;
+    runs->serial.step(steps);
+    runs->decomposed.step(steps);
+    const dem::ParticleStore& ref = runs->serial.particles();
+    const dem::ParticleStore& p = runs->decomposed.particles();
+    const std::vector<long> index = indexById(ref, static_cast<std::size_t>(runs->serial.nextId()));
+    double xError = 0.0;
+    std::int64_t unknown = 0;
+    for (std::size_t i = 0; i < runs->decomposed.ownedCount(); ++i) {
+        const long k = index[static_cast<std::size_t>(p.id[i])];
+        if (k < 0) {
+            ++unknown;
+            continue;
+        }
+        xError = std::max(xError, (p.position[i] - ref.position[k]).norm());
+    }
+    xError = comm.max(xError);
+    EXPECT_EQ(comm.sum(unknown), 0);
+    EXPECT_LE(xError, 1e-9) << "largest position deviation from the serial run [m]";
+    const dem::LiquidState serialEnd = runs->serial.liquid();
+    const dem::LiquidState mineEnd = runs->decomposed.liquidOverRanks();
+    EXPECT_EQ(mineEnd.bridgeCount, serialEnd.bridgeCount);
+    const double held = runs->decomposed.liquidInBridges();
+    EXPECT_NEAR(held + mineEnd.poolVolume, total, 1e-12 * total) << "bridges + pool = the water added";
+    EXPECT_NEAR(mineEnd.poolVolume, serialEnd.poolVolume, 1e-12 * total);
+    EXPECT_GT(runs->serial.lostCount(), 0u) << "the case should lose (wet) particles through the open top";
+    EXPECT_GT(runs->serial.pairList().buildCount(), 5) << "the liquid is shared again at every list build";
+    EXPECT_EQ(comm.sum(static_cast<std::int64_t>(runs->decomposed.lostCount())),
+              static_cast<std::int64_t>(runs->serial.lostCount()));
+    if (comm.rank() == 0)
+        std::printf("wet, %ld steps: position error %.3e m; %zu bridges (%ld across slab faces at step 1), %zu wall "
+                    "bridges; liquid in bridges %.17g of %.17g m^3, pool %.3g; %zu lost; %ld list builds\n",
+                    steps + 1, xError, mineEnd.bridgeCount, static_cast<long>(straddling), mineEnd.wallBridgeCount,
+                    held, total, mineEnd.poolVolume, runs->serial.lostCount(),
+                    runs->decomposed.pairList().buildCount());
 }
 
 }  // namespace decomposition_checks

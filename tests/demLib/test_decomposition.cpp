@@ -7,7 +7,12 @@
 // mpi/test_mpi_decomposition.cpp under mpirun).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <map>
 #include <limits>
 #include <stdexcept>
 #include <memory>
@@ -20,6 +25,7 @@
 #include "demLib/domain_decomposition.hpp"
 #include "demLib/error.hpp"
 #include "demLib/ghost_exchange.hpp"
+#include "demLib/liquid_bridges_over_ranks.hpp"
 #include "demLib/simulation.hpp"
 #include "thread_count.hpp"
 
@@ -112,17 +118,11 @@ TEST(Decomposition, RefusesWhatItDoesNotSupportYet) {
         sim.insert(c.particles, 0, Vec3::Zero());
         EXPECT_THROW(sim.setDecomposition(oneRankDecomposition()), dem::InputError);  // after insertion
     }
-    {
-        dem::Simulation sim = c.make();
-        sim.setDecomposition(oneRankDecomposition());
-        sim.insert(c.particles, 0, Vec3::Zero());
-        EXPECT_THROW(sim.writeRestart("never_written.h5"), dem::InputError);
-        EXPECT_THROW(sim.setWaterContent(0.01), dem::InputError);
-    }
-    Case wet = c;
-    wet.settings.forces.cohesion = dem::CohesionModel::Capillary;
-    dem::Simulation sim = wet.make();
-    EXPECT_THROW(sim.setDecomposition(oneRankDecomposition()), dem::InputError);
+    // A restart file is read into a decomposed simulation before any insertion.
+    dem::Simulation sim = c.make();
+    sim.setDecomposition(oneRankDecomposition());
+    sim.insert(c.particles, 0, Vec3::Zero());
+    EXPECT_THROW(sim.readRestart("never_read.h5"), dem::InputError);
 }
 
 // On one rank the decomposed path has no ghosts, but still carries all pair
@@ -161,6 +161,184 @@ TEST(Decomposition, OneRankReproducesTheSerialEngineBitwise) {
             ++differ;
     }
     EXPECT_EQ(differ, 0u) << "particles whose state differs from the serial run";
+}
+
+// The wet gas on one rank of the decomposition: the liquid is shared by the
+// serial rule (one rank), so every bit matches the serial engine.
+TEST(Decomposition, OneRankWetRunReproducesTheSerialEngineBitwise) {
+    OneThread one;
+    const Case c = wetGas();
+    dem::Simulation serial = c.make();
+    serial.insert(c.particles, 0, Vec3::Zero());
+    setMotionById(serial, c);
+    serial.setWaterContent(c.waterContent);
+    dem::Simulation decomposed = c.make();
+    decomposed.setDecomposition(oneRankDecomposition());
+    decomposed.insert(c.particles, 0, Vec3::Zero());
+    setMotionById(decomposed, c);
+    decomposed.setWaterContent(c.waterContent);
+    serial.step(300);
+    decomposed.step(300);
+    const dem::ParticleStore& a = serial.particles();
+    const dem::ParticleStore& b = decomposed.particles();
+    ASSERT_EQ(a.size(), b.size());
+    EXPECT_GT(serial.liquid().bridgeCount, 100u);
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < a.size(); ++i)
+        if (a.id[i] != b.id[i] || a.position[i] != b.position[i] || a.velocity[i] != b.velocity[i] ||
+            a.force[i] != b.force[i])
+            ++differ;
+    EXPECT_EQ(differ, 0u);
+    EXPECT_EQ(serial.pairList().bridgeVolume(), decomposed.pairList().bridgeVolume());
+    EXPECT_EQ(serial.liquid().bridgeCount, decomposed.liquidOverRanks().bridgeCount);
+}
+
+TEST(ThreadRanks, WetRunSharesTheSerialLiquid) {
+    for (int ranks : {2, 3, 4})
+        dem::Communicator::runThreadGroup(ranks, decomposition_checks::wetRunSharesTheSerialLiquid);
+}
+
+// The whole state of a run by global id, gathered on rank 0: particles
+// (position, velocity, spin) and the pairs with history or a bridge (by
+// smaller id first; history seen from the smaller id).
+struct RunState {
+    std::map<std::int64_t, std::array<double, 9>> particles;
+    std::map<std::pair<std::int64_t, std::int64_t>, std::array<double, 7>> pairs;
+    std::size_t wallRecords = 0;
+};
+
+void gatherState(const dem::Communicator& comm, const dem::Simulation& sim, RunState& into) {
+    const dem::ParticleStore& p = sim.particles();
+    const std::size_t owned = sim.ownedCount();
+    std::vector<double> mine;
+    for (std::size_t i = 0; i < owned; ++i) {
+        mine.push_back(1.0);
+        mine.push_back(static_cast<double>(p.id[i]));
+        for (const Vec3* v : {&p.position[i], &p.velocity[i], &p.omega[i]})
+            for (int d = 0; d < 3; ++d) mine.push_back((*v)[d]);
+    }
+    const auto& offsets = sim.pairList().offsets();
+    const auto& neighbors = sim.pairList().neighbors();
+    const dem::PairStateView state = sim.pairList().state();
+    for (std::size_t i = 0; i < owned; ++i)
+        for (int k = offsets[i]; k < offsets[i + 1]; ++k) {
+            const std::size_t j = static_cast<std::size_t>(neighbors[k]);
+            if (j >= owned && p.id[j] < p.id[i]) continue;  // the other rank's to report
+            dem::PairState s = state[k];
+            if (s.bridgeVolume == 0.0 && s.contact.shear.isZero(0.0) && s.contact.rollingAngle.isZero(0.0)) continue;
+            const double sign = p.id[i] < p.id[j] ? 1.0 : -1.0;
+            mine.push_back(2.0);
+            mine.push_back(static_cast<double>(std::min(p.id[i], p.id[j])));
+            mine.push_back(static_cast<double>(std::max(p.id[i], p.id[j])));
+            mine.push_back(s.bridgeVolume);
+            for (int d = 0; d < 3; ++d) mine.push_back(sign * s.contact.shear[d]);
+            for (int d = 0; d < 3; ++d) mine.push_back(sign * s.contact.rollingAngle[d]);
+        }
+    std::size_t walls = 0;
+    for (const auto& r : sim.wallContacts().records())
+        if (static_cast<std::size_t>(r.particle) < owned) ++walls;
+    const std::int64_t wallRecords = comm.sum(static_cast<std::int64_t>(walls));
+    const auto all = dem::gatherFromAllRanks(comm, mine);
+    if (comm.rank() != 0) return;
+    into = RunState();
+    into.wallRecords = static_cast<std::size_t>(wallRecords);
+    for (const auto& part : all)
+        for (std::size_t at = 0; at < part.size();) {
+            if (part[at] == 1.0) {
+                std::array<double, 9> v;
+                std::copy(part.begin() + at + 2, part.begin() + at + 11, v.begin());
+                EXPECT_TRUE(into.particles.emplace(static_cast<std::int64_t>(part[at + 1]), v).second)
+                    << "particle owned twice";
+                at += 11;
+            } else {
+                std::array<double, 7> v;
+                std::copy(part.begin() + at + 3, part.begin() + at + 10, v.begin());
+                into.pairs[{static_cast<std::int64_t>(part[at + 1]), static_cast<std::int64_t>(part[at + 2])}] = v;
+                at += 10;
+            }
+        }
+}
+
+double largestPositionDifference(const RunState& a, const RunState& b) {
+    double largest = 0.0;
+    for (const auto& [id, v] : a.particles) {
+        const auto it = b.particles.find(id);
+        if (it == b.particles.end()) return std::numeric_limits<double>::infinity();
+        for (int d = 0; d < 3; ++d) largest = std::max(largest, std::abs(v[d] - it->second[d]));
+    }
+    return largest;
+}
+
+// A wet run with contact history written on N ranks (and by the serial
+// engine) continues on M ranks: right after reading, every particle, pair
+// history, bridge and wall contact is the written one, bit for bit; continued
+// on the same N the run is bitwise the uninterrupted one, on another M it
+// follows it to round-off.
+TEST(ThreadRanks, RestartWrittenOnNRanksContinuesOnM) {
+    OneThread one;
+    const Case c = wetGas();
+    const long before = 120, after = 120;
+    auto decomposedRun = [&](const dem::Communicator& comm) {
+        auto sim = std::make_unique<dem::Simulation>(c.make());
+        sim->setDecomposition(std::make_shared<dem::GhostExchange>(
+            comm, dem::SlabDecomposition::uniform(comm.size(), 0, c.xLower, c.xUpper)));
+        return sim;
+    };
+    for (int writers : {0, 1, 2, 3}) {  // 0: the serial engine writes
+        const std::string file = ::testing::TempDir() + "decomposed_restart_" + std::to_string(writers) + ".h5";
+        RunState written, uninterrupted;
+        auto writeAndGoOn = [&](dem::Simulation& sim, const dem::Communicator& comm) {
+            sim.insert(c.particles, 0, Vec3::Zero());
+            setMotionById(sim, c);
+            sim.setWaterContent(c.waterContent);
+            sim.step(before);
+            sim.writeRestart(file);
+            gatherState(comm, sim, written);
+            sim.step(after);
+            gatherState(comm, sim, uninterrupted);
+        };
+        if (writers == 0) {
+            dem::Simulation sim = c.make();
+            writeAndGoOn(sim, dem::Communicator::serial());
+        } else {
+            dem::Communicator::runThreadGroup(writers, [&](const dem::Communicator& comm) {
+                auto sim = decomposedRun(comm);
+                writeAndGoOn(*sim, comm);
+            });
+        }
+        ASSERT_GT(written.pairs.size(), 200u);
+        ASSERT_GT(written.wallRecords, 5u);
+        for (int readers : {0, 1, 2, 3, 4}) {
+            SCOPED_TRACE("written on " + std::to_string(writers) + " ranks, read on " + std::to_string(readers));
+            RunState read, continued;
+            auto readAndGoOn = [&](dem::Simulation& sim, const dem::Communicator& comm) {
+                sim.readRestart(file);
+                gatherState(comm, sim, read);
+                sim.step(after);
+                gatherState(comm, sim, continued);
+            };
+            if (readers == 0) {
+                dem::Simulation sim = c.make();
+                readAndGoOn(sim, dem::Communicator::serial());
+            } else {
+                dem::Communicator::runThreadGroup(readers, [&](const dem::Communicator& comm) {
+                    auto sim = decomposedRun(comm);
+                    readAndGoOn(*sim, comm);
+                });
+            }
+            EXPECT_EQ(read.particles, written.particles);
+            EXPECT_EQ(read.pairs, written.pairs);
+            EXPECT_EQ(read.wallRecords, written.wallRecords);
+            // One rank and the serial engine are the same run (bitwise, above).
+            const bool sameRun = readers == writers || readers + writers == 1;
+            if (sameRun)
+                EXPECT_TRUE(continued.particles == uninterrupted.particles && continued.pairs == uninterrupted.pairs)
+                    << "continued on as many ranks: expected the uninterrupted run bit for bit";
+            else
+                EXPECT_LE(largestPositionDifference(continued, uninterrupted), 1e-9);
+        }
+        std::remove(file.c_str());
+    }
 }
 
 // Ranks that are threads of this process: the same collectives as MPI's,

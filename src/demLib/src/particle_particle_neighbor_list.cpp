@@ -55,12 +55,12 @@ void ParticleParticleNeighborList::build(const ParticleStore& particles, std::si
 
 void ParticleParticleNeighborList::restore(const ParticleStore& particles,
                                            const std::vector<Vec3>& positionAtBuild,
-                                           long buildCount) {
+                                           long buildCount, std::size_t listedRows) {
     offsets_.assign(1, 0);
     neighbors_.clear();
     history_.reset(0);
     bridgeVolume_.clear();
-    buildFrom(particles, positionAtBuild);
+    buildFrom(particles, positionAtBuild, listedRows);
     positionAtBuild_ = positionAtBuild;
     buildCount_ = buildCount;
 }

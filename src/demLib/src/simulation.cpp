@@ -10,6 +10,7 @@
 #include "demLib/contact_stability.hpp"
 #include "demLib/error.hpp"
 #include "demLib/integrator.hpp"
+#include "demLib/liquid_bridges_over_ranks.hpp"
 #include "demLib/parallel.hpp"
 #include "demLib/particle_reordering.hpp"
 
@@ -152,7 +153,9 @@ void Simulation::insert(const std::vector<InsertedParticle>& inserted, int mater
                                  w.name + "'; expected every particle clear of the walls");
         }
     }
-    requireNoDeepOverlap(inserted, particles_, context);
+    // With a decomposition each rank sees only its own particles: a refusal
+    // on one rank is a refusal on all.
+    requireOnAllRanks([&] { requireNoDeepOverlap(inserted, particles_, context); });
     // The time step is checked before anything is added, so that a rejected
     // insertion leaves the simulation as it was.
     requireTimeStepBelow(settings_, timeStepLimits(inserted, materialIndex), context);
@@ -193,8 +196,21 @@ Simulation::TimeStepLimits Simulation::timeStepLimits(const std::vector<Inserted
         if (radius < smallestRadius) smallestRadius = radius, smallestMaterial = material;
         if (radius > largestRadius) largestRadius = radius, largestMaterial = material;
     };
-    for (std::size_t i = 0; i < particles_.size(); ++i) consider(particles_.radius[i], particles_.material[i]);
+    for (std::size_t i = 0; i < ownedCount(); ++i) consider(particles_.radius[i], particles_.material[i]);
     for (const InsertedParticle& q : adding) consider(q.radius, materialIndex);
+    if (decomposition_) {
+        // Every rank must reach the same verdict: the limits of the whole run.
+        const Communicator& comm = decomposition_->communicator();
+        limits.rayleigh = comm.min(limits.rayleigh);
+        limits.hertz = comm.min(limits.hertz);
+        const double smallest = comm.min(smallestRadius), largest = comm.max(largestRadius);
+        smallestMaterial = static_cast<int>(
+            comm.min(smallestRadius == smallest ? static_cast<double>(smallestMaterial) : infinity));
+        largestMaterial = static_cast<int>(
+            comm.min(largestRadius == largest ? static_cast<double>(largestMaterial) : infinity));
+        smallestRadius = smallest;
+        largestRadius = largest;
+    }
     if (settings_.forces.cohesion == CohesionModel::Capillary && largestRadius > 0.0)
         limits.capillary = settings_.maxCapillaryClusterFraction *
                            capillaryClusterStableTimeStep(smallestRadius, materials_[smallestMaterial], largestRadius,
@@ -215,10 +231,6 @@ void Simulation::requireAllowedTimeStep(const std::string& context) const {
 void Simulation::setDecomposition(std::shared_ptr<GhostExchange> decomposition) {
     if (!particles_.empty() || nextId_ != 0)
         throw InputError(settings_.source + ": the domain decomposition must be set before any particle is inserted");
-    if (settings_.forces.cohesion == CohesionModel::Capillary)
-        throw InputError(settings_.source + ": capillary cohesion is not available with MPI domain decomposition "
-                                            "yet (the liquid is shared over all bridges of the run); expected "
-                                            "'cohesion none' or a single process");
     decomposition_ = std::move(decomposition);
     forcesValid_ = false;
 }
@@ -228,9 +240,40 @@ void Simulation::requireNoDecomposition(const std::string& what) const {
         throw InputError(settings_.source + ": " + what + " is not available with MPI domain decomposition yet");
 }
 
+template <class Check>
+void Simulation::requireOnAllRanks(const Check& check) const {
+    if (!decomposition_) return check();
+    std::string failure;
+    try {
+        check();
+    } catch (const InputError& e) {
+        failure = e.what();
+    }
+    if (!decomposition_->communicator().anyTrue(!failure.empty())) return;
+    throw InputError(!failure.empty() ? failure
+                                      : settings_.source + ": another rank of the domain decomposition refused the "
+                                                           "input (its message is in that rank's output)");
+}
+
+std::vector<std::uint8_t> Simulation::countedPairs() const {
+    const auto& offsets = pairs_.offsets();
+    const auto& neighbors = pairs_.neighbors();
+    std::vector<std::uint8_t> counted(neighbors.size(), 1);
+    if (!decomposition_) return counted;
+    const std::size_t owned = ownedCount();
+    for (std::size_t i = 0; i + 1 < offsets.size(); ++i)
+        for (int k = offsets[i]; k < offsets[i + 1]; ++k) {
+            const std::size_t j = static_cast<std::size_t>(neighbors[k]);
+            counted[k] = j < owned || particles_.id[i] < particles_.id[j];
+        }
+    return counted;
+}
+
 void Simulation::setWaterContent(double w) {
-    requireNoDecomposition("setWaterContent (capillary liquid)");
-    const double volume = waterVolumeFromContent(w, particles_.totalMass(), 1000.0, settings_.source);
+    double mass = 0.0;
+    for (std::size_t i = 0; i < ownedCount(); ++i) mass += particles_.mass[i];
+    if (decomposition_) mass = decomposition_->communicator().sum(mass);
+    const double volume = waterVolumeFromContent(w, mass, 1000.0, settings_.source);
     liquid_.waterContent = w;
     // Water added for new particles waits in the pool until the next update.
     liquid_.poolVolume += volume - liquid_.totalVolume;
@@ -260,6 +303,16 @@ struct CompensatedSum {
 
 double Simulation::liquidInBridges() const {
     CompensatedSum total;
+    if (decomposition_) {
+        const std::vector<std::uint8_t> counted = countedPairs();
+        const std::vector<double>& bridge = pairs_.bridgeVolume();
+        for (std::size_t k = 0; k < bridge.size(); ++k)
+            if (counted[k]) total.add(bridge[k]);
+        const std::size_t owned = ownedCount();
+        for (const WallContactRecord& r : wallContacts_.records())
+            if (static_cast<std::size_t>(r.particle) < owned) total.add(r.bridgeVolume);
+        return decomposition_->communicator().sum(total.sum);
+    }
     for (double v : pairs_.bridgeVolume()) total.add(v);
     for (const WallContactRecord& r : wallContacts_.records()) total.add(r.bridgeVolume);
     return total.sum;
@@ -267,12 +320,50 @@ double Simulation::liquidInBridges() const {
 
 double Simulation::liquidInWallBridges() const {
     CompensatedSum total;
+    if (decomposition_) {
+        // A ghost's wall records are its owner's business.
+        const std::size_t owned = ownedCount();
+        for (const WallContactRecord& r : wallContacts_.records())
+            if (static_cast<std::size_t>(r.particle) < owned) total.add(r.bridgeVolume);
+        return decomposition_->communicator().sum(total.sum);
+    }
     for (const WallContactRecord& r : wallContacts_.records()) total.add(r.bridgeVolume);
     return total.sum;
 }
 
 double Simulation::liquidCoordinationNumber() const {
+    if (decomposition_) {
+        const double particles = static_cast<double>(
+            decomposition_->communicator().sum(static_cast<std::int64_t>(ownedCount())));
+        const LiquidState now = liquidOverRanks();
+        return particles == 0.0 ? 0.0 : 2.0 * static_cast<double>(now.bridgeCount) / particles;
+    }
     return particles_.empty() ? 0.0 : 2.0 * static_cast<double>(liquid_.bridgeCount) / particles_.size();
+}
+
+LiquidState Simulation::liquidOverRanks() const {
+    if (!decomposition_) return liquid_;
+    const Communicator& comm = decomposition_->communicator();
+    const std::vector<std::uint8_t> counted = countedPairs();
+    const std::vector<double>& bridge = pairs_.bridgeVolume();
+    std::int64_t bridges = 0, wallBridges = 0;
+    CompensatedSum held;
+    for (std::size_t k = 0; k < bridge.size(); ++k)
+        if (counted[k] && bridge[k] > 0.0) {
+            ++bridges;
+            held.add(bridge[k]);
+        }
+    const std::size_t owned = ownedCount();
+    for (const WallContactRecord& r : wallContacts_.records())
+        if (static_cast<std::size_t>(r.particle) < owned && r.bridgeVolume > 0.0) {
+            ++wallBridges;
+            held.add(r.bridgeVolume);
+        }
+    LiquidState now = liquid_;
+    now.bridgeCount = static_cast<std::size_t>(comm.sum(bridges));
+    now.wallBridgeCount = static_cast<std::size_t>(comm.sum(wallBridges));
+    now.poolVolume = now.totalVolume - comm.sum(held.sum);
+    return now;
 }
 
 double Simulation::coordinationNumber() const {
@@ -330,8 +421,11 @@ void Simulation::removeLostParticles(bool knownNoneLost) {
 
 void Simulation::updatePairList() {
     if (decomposition_) {
-        // History to the id-keyed stash, ghosts away, particles to their owners.
+        // History to the id-keyed stash, ghosts away, the slabs re-cut when
+        // the owned counts drifted apart (the powder moved), particles to
+        // their owners.
         decomposition_->dropGhosts(particles_, pairs_, wallContacts_);
+        decomposition_->rebalanceIfNeeded(particles_);
         decomposition_->migrate(particles_);
     }
     double rMax = 0.0;
@@ -339,12 +433,17 @@ void Simulation::updatePairList() {
     // The same skin on every rank as in a one-rank run.
     if (decomposition_) rMax = decomposition_->communicator().max(rMax);
     double extra = 0.0;
-    if (liquidNetwork_ && !particles_.empty()) {
+    if (liquidNetwork_ && (decomposition_ || !particles_.empty())) {
         // Bridges can only form between listed pairs: reach out to the debonding
         // distance of a bridge larger than any seen so far (and at least of the
         // liquid of one particle, which bounds a bridge at the first update).
-        const double perParticle = liquid_.totalVolume / particles_.size();
-        extra = debondingDistance(std::max(1.5 * largestBridge_, perParticle), settings_.bridges.contactAngle);
+        const double particles = decomposition_ ? static_cast<double>(decomposition_->communicator().sum(
+                                                      static_cast<std::int64_t>(particles_.size())))
+                                                : static_cast<double>(particles_.size());
+        if (particles > 0.0) {
+            const double perParticle = liquid_.totalVolume / particles;
+            extra = debondingDistance(std::max(1.5 * largestBridge_, perParticle), settings_.bridges.contactAngle);
+        }
     }
     const double skin = settings_.skinFraction * 2.0 * rMax;
     // Neighbours in space become neighbours in memory: the force loop's reads of
@@ -365,8 +464,9 @@ void Simulation::updatePairList() {
     // (in a polydisperse wet bed the range of the largest bridge lists 3x
     // more pairs).  Should the new λ exceed the limit, the list is made again
     // without it (below): the results never depend on it.  (Bridges formed at
-    // contact only, and MPI runs, list the whole range.)
-    const bool limitBridgePairs = liquidNetwork_ && !decomposition_ &&
+    // contact only list the whole range.  With a decomposition λ is the
+    // run's, so every rank relists or not alike.)
+    const bool limitBridgePairs = liquidNetwork_ &&
                                   settings_.bridges.formation == BridgeFormation::WithinDebondingDistance;
     pairs_.setBridgeListing(settings_.bridges,
                             limitBridgePairs ? bridgeListingLimit_ : std::numeric_limits<double>::infinity());
@@ -384,7 +484,7 @@ void Simulation::updatePairList() {
         // (With a margin for the rounding of λ = V / Σw against λ*_k Σw <= V.)
         if (liquidPerWeight * (1.0 + 1e-9) > pairs_.bridgeListingLimit()) {
             pairs_.setBridgeListing(settings_.bridges, std::numeric_limits<double>::infinity());
-            pairs_.relistAtBuildPositions(particles_);
+            pairs_.relistAtBuildPositions(particles_, ownedCount());
             ++bridgeRelists_;
             liquidPerWeight = redistributeLiquid(extra);
         }
@@ -409,7 +509,7 @@ void Simulation::wallBridgeCandidates(double reach, std::vector<WallContactRecor
     gaps.clear();
     std::vector<std::pair<WallContactRecord, double>> near;
     WallProximityQuery query(walls_, time_);
-    for (std::size_t i = 0; i < particles_.size(); ++i) {
+    for (std::size_t i = 0; i < ownedCount(); ++i) {  // a ghost's wall bridges are its owner's
         near.clear();
         query.forEachNear(particles_.position[i], particles_.radius[i], reach, [&](int w, const WallContact& c) {
             WallContactRecord r;
@@ -457,7 +557,17 @@ double Simulation::redistributeLiquid(double wallReach) {
             candidates.add(radius, radius, 2.0 * radius + wallGaps[m], wallRecords[m].bridgeVolume > 0.0);
         }
     }
-    const BridgeDistribution& d = liquidNetwork_->update(candidates);
+    // Over ranks: the pairs this rank accounts for, then every wall candidate
+    // (of owned particles only, wallBridgeCandidates).
+    const bool overRanks = decomposition_ && !decomposition_->communicator().isSerial();
+    BridgeDistribution sharedOverRanks;
+    if (overRanks) {
+        std::vector<std::uint8_t> counted = countedPairs();
+        counted.resize(candidates.size(), 1);
+        sharedOverRanks = distributeLiquidOverRanks(candidates, counted, liquid_.totalVolume, settings_.bridges,
+                                                    decomposition_->communicator());
+    }
+    const BridgeDistribution& d = overRanks ? sharedOverRanks : liquidNetwork_->update(candidates);
     largestBridge_ = 0.0;
     liquid_.bridgeCount = 0;
     liquid_.wallBridgeCount = 0;
@@ -479,6 +589,16 @@ double Simulation::redistributeLiquid(double wallReach) {
             std::max(wallReach, debondingDistance(largestBridge_, settings_.bridges.contactAngle)));
     }
     liquid_.poolVolume = d.freeLiquid;
+    if (decomposition_) {
+        // The same list range and bridge reach on every rank; the run's counts.
+        const Communicator& comm = decomposition_->communicator();
+        largestBridge_ = comm.max(largestBridge_);
+        if (settings_.forces.wallBridges)
+            wallContacts_.setBridgeReach(std::max(wallReach, debondingDistance(largestBridge_, settings_.bridges.contactAngle)));
+        const LiquidState now = liquidOverRanks();
+        liquid_.bridgeCount = now.bridgeCount;
+        liquid_.wallBridgeCount = now.wallBridgeCount;
+    }
     return d.liquidPerWeight;
 }
 
@@ -486,7 +606,9 @@ void Simulation::computeForces(bool forcesReset) {
     if (!forcesReset) resetForces(particles_, settings_.gravity);
     last_.contacts = kernel_->compute(particles_, pairs_, wallContacts_, walls_, wallCandidates_, interactions_,
                                       time_, settings_.timeStep);
-    if (liquidNetwork_) {
+    // With a decomposition a pair across a slab face breaks on both ranks: the
+    // run's counts come from liquidOverRanks() (collective), not from here.
+    if (liquidNetwork_ && !decomposition_) {
         liquid_.poolVolume += last_.contacts.releasedLiquid;
         liquid_.bridgeCount = last_.contacts.bridges;
         liquid_.wallBridgeCount = last_.contacts.wallBridges;

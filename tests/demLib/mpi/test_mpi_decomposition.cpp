@@ -46,6 +46,11 @@ TEST(MpiDecomposition, MultiStepRunFollowsTheSerialRun) {
     multiStepRunFollowsTheSerialRun(world());
 }
 
+TEST(MpiDecomposition, WetRunSharesTheSerialLiquid) {
+    OneThread one;
+    wetRunSharesTheSerialLiquid(world());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {

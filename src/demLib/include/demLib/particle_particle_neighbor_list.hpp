@@ -139,8 +139,9 @@ public:
     // Restart support: the list is a pure function of the positions at the last
     // build (and the bridge listing limit, set before), so restoring those and
     // rebuilding reproduces it exactly.
+    // listedRows as in build() (the owned particles of an MPI rank).
     void restore(const ParticleStore& particles, const std::vector<Vec3>& positionAtBuild,
-                 long buildCount);
+                 long buildCount, std::size_t listedRows = static_cast<std::size_t>(-1));
     // Installs saved pair state for pair (i, j), i < j, after restore(); parts
     // the list does not keep are ignored.
     bool setState(int i, int j, const PairState& s);

@@ -103,8 +103,9 @@ public:
     // neighbours' particles after them.  Set before any particle is inserted;
     // every rank then calls insert() with the same particles (ids are given
     // the same on all ranks, each keeps those it owns) and step() the same
-    // number of times.  Not available with capillary cohesion or restart
-    // files yet (InputError).
+    // number of times.  Capillary bridges share the run's water over all
+    // ranks (liquid_bridges_over_ranks.hpp); restart files are written
+    // gathered by rank 0 and can be read on any rank count (writeRestart).
     void setDecomposition(std::shared_ptr<GhostExchange> decomposition);
     const GhostExchange* decomposition() const { return decomposition_.get(); }
     // Particles integrated by this rank: all of them without a decomposition,
@@ -128,13 +129,19 @@ public:
     long bridgeRelistCount() const { return bridgeRelists_; }
     const ParticleWallContacts& wallContacts() const { return wallContacts_; }
     const StepStatistics& lastStep() const { return last_; }
+    // With a decomposition: the run's values (all ranks) as of the last list
+    // build; liquidOverRanks() gives the current ones.
     const LiquidState& liquid() const { return liquid_; }
+    // The liquid state now, summed over the ranks (a pair across a slab face
+    // counted once).  Collective with a decomposition; liquid() without one.
+    LiquidState liquidOverRanks() const;
     std::size_t lostCount() const { return lost_; }
     double lostMass() const { return lostMass_; }
     std::int64_t nextId() const { return nextId_; }
 
     // Liquid volume held by all bridges, particle-particle and particle-wall
-    // (plus liquid().poolVolume it is the conserved total).
+    // (plus liquid().poolVolume it is the conserved total).  With a
+    // decomposition this and the two below are collectives over all ranks.
     double liquidInBridges() const;
     // The part of liquidInBridges() held by particle-wall bridges.
     double liquidInWallBridges() const;
@@ -166,6 +173,11 @@ public:
     // Restart: the whole state, contact history included.  The file's attributes and
     // each dataset carry checksums; readRestart throws DamagedFileError when one does not
     // match, and returns false for a file written before checksums (read unchecked).
+    // With a decomposition both are collectives: rank 0 gathers the ranks'
+    // particles and writes one file (the same format), and reads a file of any
+    // rank count (or a serial one) into a simulation without particles, giving
+    // each rank its particles; on the rank count that wrote it the run
+    // continues bitwise as it would have.
     void writeRestart(const std::string& path) const;
     bool readRestart(const std::string& path);
 
@@ -183,6 +195,19 @@ private:
     // forcesReset: F = m g + F_external and T = 0 are set already (by the drift).
     void computeForces(bool forcesReset);
     void requireNoDecomposition(const std::string& what) const;
+    // Per list entry: 1 where this rank accounts for the pair (every pair of
+    // two owned particles; a pair with a ghost on the rank owning the smaller
+    // id), so that sums over ranks count each pair once.
+    std::vector<std::uint8_t> countedPairs() const;
+    // Runs `check`; with a decomposition a failure on any rank is a failure
+    // on all (with the failing rank's message where it is known), so that no
+    // rank goes on to a collective the others never reach.
+    template <class Check>
+    void requireOnAllRanks(const Check& check) const;
+    // Restart with a decomposition: rank 0 reads and hands out (simulation_restart.cpp).
+    bool readRestartDecomposed(const std::string& path);
+    // Time, counts, liquid and list settings of a restart file's header.
+    void applyRestartScalars(const std::vector<double>& header);
 
     SimulationSettings settings_;
     std::vector<Material> materials_;
