@@ -1,5 +1,5 @@
 // demRun: runs a DEM-only case (no air), e.g. the calibration tutorials.
-//   demRun [-case DIR] [-restart FILE|latest] [-threads N] [-help]
+//   demRun [-case DIR] [-restart FILE|latest] [-threads N] [-parallel] [-help]
 // Reads DIR/constant/demProperties, writes DIR/<output>/ (particle fields as
 // HDF5 + XDMF for ParaView, summary.csv, restart files) and DIR/log.demRun.
 #include <cmath>
@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 
@@ -19,9 +21,13 @@
 #include "demLib/case_lock.hpp"
 #include "demLib/case_runner.hpp"
 #include "demLib/command_line.hpp"
+#include "demLib/config.hpp"
 #include "demLib/error.hpp"
 #include "demLib/stop_signal.hpp"
 #include "demLib/version.hpp"
+#if DEMLIB_HAS_MPI
+#include "demLib/communicator_mpi.hpp"
+#endif
 
 namespace {
 
@@ -65,6 +71,9 @@ void usage(std::ostream& out) {
            "  -threads N         OpenMP threads (default: OMP_NUM_THREADS or all cores)\n"
            "  -endTime T         stop at T seconds instead of the case's endTime\n"
            "  -quiet             no progress lines\n"
+           "  -parallel          run the DEM spread over the processes of an MPI launcher, e.g.\n"
+           "                     mpirun -np 4 demRun -case DIR -parallel (each rank steps the particles of\n"
+           "                     its slab; one thread per rank unless -threads; docs/parallel.md)\n"
            "  -help              this text\n\n"
            "Writes into the case: log.demRun (a run with -restart adds to it), <output>/particles.xdmf\n"
            "(+ particles_*.h5; open the .xdmf in ParaView), <output>/summary.csv, <output>/restart/restart_*.h5.\n"
@@ -81,6 +90,7 @@ int main(int argc, char** argv) {
     dem::RunOptions options;
     double endTime = -1.0;
     int threads = 0;
+    bool parallel = false;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         auto value = [&](const char* what) -> std::string {
@@ -113,12 +123,48 @@ int main(int argc, char** argv) {
             }
         } else if (a == "-quiet") {
             options.progressInterval = 0.0;
+        } else if (a == "-parallel") {
+            parallel = true;
         } else {
             std::cerr << "demRun: unknown option '" << a << "'\n";
             usage(std::cerr);
             return 1;
         }
     }
+    // -parallel: MPI starts here (demLib never starts it) and every rank runs
+    // the case; rank 0 writes the log and the outputs.
+    int rank = 0;
+    if (parallel) {
+#if DEMLIB_HAS_MPI
+        int provided = 0;
+        MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
+        options.communicator = dem::communicatorFromMpi(MPI_COMM_WORLD);
+        rank = options.communicator.rank();
+        if (options.communicator.size() < 2) {
+            std::cerr << "demRun: -parallel runs under an MPI launcher with 2 or more processes, e.g. "
+                         "mpirun -np 4 demRun -case " << caseDir << " -parallel; without it run demRun alone\n";
+            MPI_Finalize();
+            return 1;
+        }
+        if (threads == 0) threads = 1;  // ranks share the cores: one thread each unless told
+#else
+        std::cerr << "demRun: -parallel needs demLib built with MPI (this build has none: DEMLIB_MPI off or "
+                     "MPI not found when it was configured)\n";
+        return 1;
+#endif
+    }
+    const bool writer = rank == 0;
+    // Ends an MPI run: at once (MPI_Abort) when a rank failed, since the others
+    // may wait for it in a collective.
+    auto leave = [&](int status) {
+#if DEMLIB_HAS_MPI
+        if (parallel) {
+            if (status == 0 || status >= 128) MPI_Finalize();
+            else MPI_Abort(MPI_COMM_WORLD, status);
+        }
+#endif
+        return status;
+    };
 #ifdef _OPENMP
     if (threads > 0) omp_set_num_threads(threads);
 #endif
@@ -130,10 +176,11 @@ int main(int argc, char** argv) {
     bool outputsChanged = false;
     const bool continuing = !options.restartFrom.empty();
     std::stringbuf beforeStart;
-    TeeBuffer tee(std::cout.rdbuf(), &beforeStart);
+    std::stringbuf discarded;  // the other ranks' log: rank 0 writes the run's
+    TeeBuffer tee(writer ? std::cout.rdbuf() : &discarded, writer ? &beforeStart : nullptr);
     std::ostream log(&tee);
     const auto openLog = [&] {
-        if (!std::filesystem::is_directory(caseDir)) return;
+        if (!writer || !std::filesystem::is_directory(caseDir)) return;
         logFile.open(std::filesystem::path(caseDir) / "log.demRun", continuing ? std::ios::app : std::ios::trunc);
         if (!logFile.is_open()) return;
         if (continuing)
@@ -146,12 +193,16 @@ int main(int argc, char** argv) {
 #ifdef _OPENMP
             << ", " << omp_get_max_threads() << " thread(s)"
 #endif
+            << (parallel ? " per rank, " + std::to_string(options.communicator.size()) + " MPI ranks" : std::string())
             << std::endl;
         dem::CaseSetup setup = dem::readCaseSetup(caseDir);
         if (endTime > 0.0) setup.endTime = endTime;
         // One run at a time in a case: a second one would cut the first one's results.
-        const dem::CaseLock lock(caseDir, "demRun");
-        dem::requireWritableFile(std::filesystem::path(caseDir) / "log.demRun", "the run's log");
+        std::optional<dem::CaseLock> lock;
+        if (writer) {
+            lock.emplace(caseDir, "demRun");
+            dem::requireWritableFile(std::filesystem::path(caseDir) / "log.demRun", "the run's log");
+        }
         options.outputsChanged = &outputsChanged;
         dem::CaseRunner runner(std::move(setup), options, log);
         log.flush();
@@ -161,26 +212,40 @@ int main(int argc, char** argv) {
         dem::catchStopSignals();
         const dem::Simulation& simulation = runner.simulation();
         const double end = runner.setup().endTime, dt = simulation.timeStep();
-        while (simulation.time() < end - 0.5 * dt && dem::stopSignalReceived() == 0)
+        // With ranks the stop is taken together (the launcher signals each rank).
+        const dem::Communicator& comm = options.communicator;
+        auto stopping = [&] {
+            const bool mine = dem::stopSignalReceived() != 0;
+            return comm.isSerial() ? mine : comm.anyTrue(mine);
+        };
+        while (simulation.time() < end - 0.5 * dt && !stopping())
             runner.advanceTo(simulation.time() + 200.0 * dt);  // slices: same results as one call
         runner.finish();
-        if (const int signal = dem::stopSignalReceived()) {
+        int signal = dem::stopSignalReceived();
+        if (!comm.isSerial()) signal = static_cast<int>(comm.max(static_cast<double>(signal)));
+        if (signal != 0) {
             log << "\ndemRun: stopped by " << dem::stopSignalName(signal) << " at t = "
                 << simulation.time() << " s (step " << simulation.stepCount()
                 << "), its restart file written; continue with: demRun -case " << caseDir << " -restart latest"
                 << std::endl;
-            return 128 + signal;
+            return leave(128 + signal);
         }
         log << "End. Results in " << runner.outputDirectory() << " (open particles.xdmf in ParaView)" << std::endl;
-        return 0;
+        return leave(0);
     } catch (const std::exception& e) {
         const bool inputError = dynamic_cast<const dem::InputError*>(&e) != nullptr;
+        if (!writer) {
+            // Input errors are found alike on every rank (rank 0 says it); anything
+            // else may be this rank's alone.
+            if (!inputError) std::cerr << "demRun (rank " << rank << "): error: " << e.what() << std::endl;
+            return leave(inputError ? 1 : 2);
+        }
         log << "\ndemRun: " << (inputError ? "input error: " : "error: ") << e.what() << std::endl;
         if (!outputsChanged)
             log << "demRun: the run did not start; log.demRun and the case's results are as they were" << std::endl;
         else if (!logFile.is_open())
             log << "demRun: the run stopped while it opened its output; the results in the case's output folder "
                    "may be incomplete" << std::endl;
-        return inputError ? 1 : 2;
+        return leave(inputError ? 1 : 2);
     }
 }

@@ -10,11 +10,15 @@
 #include <cstring>
 #include <filesystem>
 #include <iomanip>
+#include <limits>
+#include <memory>
 #include <sstream>
 #include <vector>
 
 #include "demLib/command_line.hpp"
 #include "demLib/error.hpp"
+#include "demLib/ghost_exchange.hpp"
+#include "demLib/liquid_bridges_over_ranks.hpp"
 
 namespace dem {
 
@@ -80,6 +84,35 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
     : setup_(std::move(setup)), options_(options), log_(log) {
     caseText_ = readText(fs::path(setup_.caseDir) / "constant" / "demProperties");
     simulation_ = makeSimulation(setup_);
+    const Communicator& comm = options_.communicator;
+    if (!comm.isSerial()) {
+        // First slabs: equal widths along the longest side of the domain box
+        // (or of the insertion regions); the load balance re-cuts them by
+        // particle count at the first list build and whenever the powder moves.
+        Vec3 low = Vec3::Constant(std::numeric_limits<double>::infinity()), high = -low;
+        if (setup_.settings.domain) {
+            low = setup_.settings.domain->min;
+            high = setup_.settings.domain->max;
+        }
+        if (!(low.array() < high.array()).all() || !high.allFinite() || !low.allFinite()) {
+            low = Vec3::Constant(std::numeric_limits<double>::infinity());
+            high = -low;
+            for (const InsertionSpec& spec : setup_.insertions)
+                if (spec.region) {
+                    low = low.cwiseMin(spec.region->boundsMin());
+                    high = high.cwiseMax(spec.region->boundsMax());
+                }
+        }
+        if (!(low.array() < high.array()).all() || !high.allFinite() || !low.allFinite()) {
+            low = Vec3::Constant(-1.0);
+            high = Vec3::Constant(1.0);
+        }
+        int axis = 0;
+        for (int d = 1; d < 3; ++d)
+            if (high[d] - low[d] > high[axis] - low[axis]) axis = d;
+        simulation_->setDecomposition(std::make_shared<GhostExchange>(
+            comm, SlabDecomposition::uniform(comm.size(), axis, low[axis], high[axis])));
+    }
     wetted_ = !(setup_.wettingTime > 0.0);
     const fs::path out = outputDirectory();
 
@@ -110,7 +143,8 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
             log_ << "Warning: restart file " << restart << " carries no checksums (written before they existed); "
                  << "read without checking its data\n";
         log_ << "Continuing from restart file " << restart << " at t = " << startTime_ << " s, step "
-             << simulation_->stepCount() << ", " << simulation_->particles().size() << " particles\n";
+             << simulation_->stepCount() << ", " << particleCount() << " particles"
+             << (comm.isSerial() ? std::string() : " on " + std::to_string(comm.size()) + " ranks") << "\n";
     }
     checkStepCount();
     for (const InsertionSpec& spec : setup_.insertions)
@@ -125,15 +159,19 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
         performDueWetting();
     }
     // Every output must be writable before the first of an earlier run's files changes.
-    requireWritableOutputs(out);
-    checkFieldOutputVolume(out);
+    const std::size_t particlesNow = particleCount();
+    if (writesFiles()) {
+        requireWritableOutputs(out);
+        checkFieldOutputVolume(out, particlesNow);
+    }
     if (options_.outputsChanged) *options_.outputsChanged = true;
-    fields_ = std::make_unique<FieldOutput>(out.string(), "particles", restart.empty() ? -1.0 : startTime_);
+    if (writesFiles())
+        fields_ = std::make_unique<FieldOutput>(out.string(), "particles", restart.empty() ? -1.0 : startTime_);
 
     // The summary keeps the lines up to the restart time and continues after them.
     const fs::path summaryPath = out / "summary.csv";
     std::vector<std::string> kept;
-    if (!restart.empty() && fs::exists(summaryPath)) {
+    if (writesFiles() && !restart.empty() && fs::exists(summaryPath)) {
         std::ifstream in(summaryPath);
         std::string line;
         bool lineAtRestart = false;
@@ -153,7 +191,14 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
         // A line at the restart time is this step's: finish() must not add it twice.
         if (lineAtRestart) lastLogStep_ = simulation_->stepCount();
     }
-    if (kept.empty()) {
+    // Every rank follows rank 0's bookkeeping of the summary (whether this
+    // step's line exists), so that all take part in the same summary lines.
+    if (!comm.isSerial())
+        lastLogStep_ = comm.anyTrue(writesFiles() && lastLogStep_ == simulation_->stepCount())
+                           ? simulation_->stepCount() : lastLogStep_;
+    if (!writesFiles()) {
+        // the other ranks write no files
+    } else if (kept.empty()) {
         summary_.open(summaryPath, std::ios::trunc);
         if (!summary_) throw RuntimeError("cannot write '" + summaryPath.string() + "': " + std::strerror(errno));
         summary_ << std::setprecision(10);
@@ -401,14 +446,14 @@ void CaseRunner::requireWritableOutputs(const fs::path& out) const {
         }
 }
 
-void CaseRunner::checkFieldOutputVolume(const fs::path& out) const {
+void CaseRunner::checkFieldOutputVolume(const fs::path& out, std::size_t particlesNow) const {
     // A fieldInterval below the time step writes a file every step (6 MB a step for
     // 49 000 particles): a run that would fill the disk is refused before it writes,
     // so that it cannot stop other runs' restart files from being written.
     const OutputSpec& o = setup_.output;
     double particles = 0.0;
     for (const InsertionSpec& spec : setup_.insertions) particles += expectedParticleCount(spec);
-    particles = std::max(particles, static_cast<double>(simulation_->particles().size()));
+    particles = std::max(particles, static_cast<double>(particlesNow));
     const double interval = std::max(o.fieldInterval, simulation_->timeStep());
     const double files = o.fieldInterval > 0.0 ? std::floor((setup_.endTime - startTime_) / interval) + 1.0 : 1.0;
     const double bytes = files * particles * 120.0;  // measured 124 bytes per particle and file
@@ -431,10 +476,28 @@ void CaseRunner::performDueInsertions() {
         const double now = simulation_->time();
         if (placed_ == 0) population_ = drawPopulation(spec);
         const ParticleStore& p = simulation_->particles();
-        const std::size_t before = p.size();
-        const std::size_t n = performInsertion(*simulation_, spec, population_, placed_);
+        const std::size_t before = particleCount();
+        const std::int64_t firstNewId = simulation_->nextId();
+        std::size_t n = 0;
+        if (options_.communicator.isSerial() || !spec.region) {
+            n = performInsertion(*simulation_, spec, population_, placed_);
+        } else {
+            // Every rank places the same particles around those of all ranks.
+            double largest = 0.0;
+            for (double d : population_) largest = std::max(largest, d);
+            for (std::size_t i = 0; i < simulation_->ownedCount(); ++i) largest = std::max(largest, 2.0 * p.radius[i]);
+            std::vector<Vec3> positions;
+            std::vector<double> radii;
+            particlesNear(*spec.region, 2.0 * options_.communicator.max(largest), positions, radii);
+            ExistingParticles existing;
+            existing.positions = &positions;
+            existing.radii = &radii;
+            n = performInsertion(*simulation_, spec, population_, placed_, &existing);
+        }
         double mass = 0.0;
-        for (std::size_t i = before; i < p.size(); ++i) mass += p.mass[i];
+        for (std::size_t i = 0; i < simulation_->ownedCount(); ++i)
+            if (p.id[i] >= firstNewId) mass += p.mass[i];
+        if (!options_.communicator.isSerial()) mass = options_.communicator.sum(mass);
         placed_ += n;
         log_ << "Inserted " << n << " particles (" << mass * 1e3 << " g) of '" << spec.name << "' at t = " << now
              << " s";
@@ -455,7 +518,7 @@ void CaseRunner::performDueInsertions() {
                  << " s (" << binding << " limit)";
         }
         if (placed_ < population_.size()) {
-            if (n == 0 && simulation_->particles().size() == before && spec.waveInterval <= 0.0)
+            if (n == 0 && particleCount() == before && spec.waveInterval <= 0.0)
                 throw InputError(spec.context + ": no particle fits in the region");
             nextWaveTime_ = now + spec.waveInterval;
             log_ << "; " << population_.size() - placed_ << " more in the next wave at t = " << nextWaveTime_
@@ -483,28 +546,44 @@ void CaseRunner::writeSummaryHeader() {
 void CaseRunner::writeSummaryLine() {
     const Simulation& s = *simulation_;
     const ParticleStore& p = s.particles();
-    summary_ << s.time() << "," << s.stepCount() << "," << p.size() << "," << p.kineticEnergy() << ","
-             << s.coordinationNumber() << "," << s.lastStep().contacts.wallContacts << "," << s.lostCount() << ","
-             << s.lostMass();
-    if (setup_.waterContent > 0.0) {
-        const LiquidState& l = s.liquid();
-        const double inBridges = s.liquidInBridges();
+    const Communicator& comm = options_.communicator;
+    // Every value of the run (collectives with a decomposition), then rank 0 writes.
+    const RunTotals totals = s.totalsOverRanks();
+    const LiquidState l = s.liquidOverRanks();
+    const bool wet = setup_.waterContent > 0.0;
+    const double inBridges = wet ? s.liquidInBridges() : 0.0;
+    const double liquidCoordination = wet ? s.liquidCoordinationNumber() : 0.0;
+    std::vector<double> regionMass;
+    for (const MonitorRegion& r : setup_.output.regions) {
+        double m = 0.0;
+        for (std::size_t i = 0; i < s.ownedCount(); ++i)
+            if (r.region->containsSphere(p.position[i], 0.0)) m += p.mass[i];
+        regionMass.push_back(m);
+    }
+    if (!comm.isSerial()) regionMass = sumOverRanksInRankOrder(comm, regionMass);
+    lastLogStep_ = s.stepCount();
+    if (!writesFiles()) return;
+    summary_ << s.time() << "," << s.stepCount() << "," << totals.particles << "," << totals.kineticEnergy << ","
+             << totals.coordinationNumber() << "," << totals.wallContacts << "," << totals.lost << ","
+             << totals.lostMass;
+    if (wet) {
         const double error = l.totalVolume > 0.0 ? (inBridges + l.poolVolume - l.totalVolume) / l.totalVolume : 0.0;
         summary_ << "," << l.totalVolume << "," << inBridges << "," << l.poolVolume << "," << error << ","
-                 << l.bridgeCount << "," << s.liquidCoordinationNumber();
+                 << l.bridgeCount << "," << liquidCoordination;
     }
-    for (const MonitorRegion& r : setup_.output.regions) summary_ << "," << massInRegion(p, *r.region);
-    for (const Vec3& f : s.wallForces()) summary_ << "," << f.x() << "," << f.y() << "," << f.z();
+    for (double m : regionMass) summary_ << "," << m;
+    for (const Vec3& f : totals.wallForces) summary_ << "," << f.x() << "," << f.y() << "," << f.z();
     summary_ << "\n";
     summary_.flush();
-    lastLogStep_ = s.stepCount();
 }
 
 void CaseRunner::writeRestart() {
     const fs::path dir = fs::path(outputDirectory()) / "restart";
     std::ostringstream name;
     name << "restart_" << std::setw(9) << std::setfill('0') << simulation_->stepCount() << ".h5";
-    simulation_->writeRestart((dir / name.str()).string());
+    simulation_->writeRestart((dir / name.str()).string());  // collective with a decomposition
+    lastRestartStep_ = simulation_->stepCount();
+    if (!writesFiles()) return;
     {
         // What the engine's restart file does not know: the insertion progress, and the
         // case file it ran with, so that a continued run can say what changed since.  Written
@@ -526,7 +605,6 @@ void CaseRunner::writeRestart() {
         out << name.str() << "\n";
     }
     fs::rename(pointer.string() + ".writing", pointer);
-    lastRestartStep_ = simulation_->stepCount();
 }
 
 bool CaseRunner::intervalDue(double interval, long next, double t) const {
@@ -539,7 +617,12 @@ void CaseRunner::writeDueOutput(bool force) {
     const OutputSpec& o = setup_.output;
     const long step = simulation_->stepCount();
     if (intervalDue(o.fieldInterval, nextField_, t) || (force && lastFieldStep_ != step)) {
-        fields_->write(*simulation_);
+        if (options_.communicator.isSerial()) {
+            fields_->write(*simulation_);
+        } else {
+            const ParticleStore all = gatheredParticles();  // collective; rank 0 holds them
+            if (writesFiles()) fields_->write(all, t, step);
+        }
         lastFieldStep_ = step;
         nextField_ = firstIndexAfter(t + eps, o.fieldInterval);
     }
@@ -557,17 +640,23 @@ void CaseRunner::progress(bool force) {
     if (options_.progressInterval <= 0.0 && !force) return;
     const auto now = std::chrono::steady_clock::now();
     const double sinceLast = std::chrono::duration<double>(now - lastProgress_).count();
-    if (!force && sinceLast < options_.progressInterval) return;
+    bool due = force || sinceLast >= options_.progressInterval;
+    // Rank 0's clock decides, so that every rank joins the totals below.
+    const Communicator& comm = options_.communicator;
+    if (!comm.isSerial()) due = comm.anyTrue(comm.rank() == 0 && due);
+    if (!due) return;
     lastProgress_ = now;
     const Simulation& s = *simulation_;
+    const RunTotals totals = s.totalsOverRanks();
+    if (!writesFiles()) return;
     const double elapsed = std::chrono::duration<double>(now - wallStart_).count();
     estimate_.add(elapsed, s.time());
     const double eta = estimate_.secondsLeft();
-    const double particleSteps = static_cast<double>(s.stepCount() - stepsAtStart_) * s.particles().size();
+    const double particleSteps = static_cast<double>(s.stepCount() - stepsAtStart_) * totals.particles;
     log_ << std::fixed << std::setprecision(4) << "t = " << s.time() << " s (" << std::setprecision(1)
          << 100.0 * s.time() / setup_.endTime << " %)" << std::defaultfloat << std::setprecision(6)
-         << "  step " << s.stepCount() << "  particles " << s.particles().size() << "  KE "
-         << s.particles().kineticEnergy() << " J  lost " << s.lostCount() << "  "
+         << "  step " << s.stepCount() << "  particles " << totals.particles << "  KE "
+         << totals.kineticEnergy << " J  lost " << totals.lost << "  "
          << std::setprecision(3) << (elapsed > 0 ? particleSteps / elapsed : 0.0) << " particle-steps/s"
          << "  elapsed " << formatDuration(elapsed) << "  ETA " << (eta >= 0.0 ? formatDuration(eta) : "-")
          << std::endl;
@@ -589,7 +678,7 @@ void CaseRunner::performDueWetting() {
     wetted_ = true;
     log_ << "Wetted at t = " << simulation_->time() << " s (keyword 'wettingTime'): liquid "
          << simulation_->liquid().totalVolume << " m^3 (w = " << setup_.waterContent << ") on "
-         << simulation_->particles().size() << " particles" << std::endl;
+         << particleCount() << " particles" << std::endl;
 }
 
 bool CaseRunner::outputDueAt(double t) const {
@@ -615,7 +704,7 @@ void CaseRunner::advanceTo(double time) {
             const double t = static_cast<double>(next) * dt;
             if (!(t < target - 0.5 * dt) || insertionDueAt(t) || wettingDueAt(t) || outputDueAt(t)) break;
         }
-        const std::size_t before = s.particles().size();
+        const std::size_t before = particleCount();
         s.step(steps);
         requireParticlesKept(before);
         performDueInsertions();
@@ -632,18 +721,98 @@ void CaseRunner::requireParticlesKept(std::size_t before) {
     // double) do.  Stopped with an error, not ended as if the run had succeeded.
     const Simulation& s = *simulation_;
     if (firstParticlesStep_ < 0 && before > 0) firstParticlesStep_ = s.stepCount();
-    if (before == 0 || s.particles().size() > 0 || firstParticlesStep_ < 0) return;
+    if (before == 0 || firstParticlesStep_ < 0 || particleCount() > 0) return;
     const double interval = setup_.output.logInterval / s.timeStep();
     const double window = std::clamp(std::isfinite(interval) ? interval : 0.0, 100.0, 10000.0);
     if (static_cast<double>(s.stepCount() - firstParticlesStep_) > window) return;
     std::ostringstream m;
-    m << std::setprecision(3) << "file '" << setup_.propertiesFile << "': every particle (" << s.lostCount()
+    m << std::setprecision(3) << "file '" << setup_.propertiesFile << "': every particle (" << s.totalsOverRanks().lost
       << ") was lost by t = " << s.time() << " s, within " << s.stepCount() - firstParticlesStep_
       << " steps of the first ones (they left the domain, or their state became infinite or NaN); expected "
          "magnitudes of physics: check the keywords 'simulation/gravity' (|g| = "
       << setup_.settings.gravity.norm() << " m/s^2), the insertions' 'velocity', the materials' 'density' and "
          "'youngsModulus', and 'simulation/domain'";
     throw InputError(m.str());
+}
+
+std::size_t CaseRunner::particleCount() const {
+    const Communicator& comm = options_.communicator;
+    const std::size_t owned = simulation_->ownedCount();
+    return comm.isSerial() ? owned : static_cast<std::size_t>(comm.sum(static_cast<std::int64_t>(owned)));
+}
+
+namespace {
+
+// Plain values between ranks of one executable.
+template <class T>
+void appendBytes(std::vector<char>& out, const T& value) {
+    const std::size_t at = out.size();
+    out.resize(at + sizeof(T));
+    std::memcpy(out.data() + at, &value, sizeof(T));
+}
+
+template <class T>
+T takeBytes(const std::vector<char>& in, std::size_t& at) {
+    if (at + sizeof(T) > in.size()) throw RuntimeError("demLib: truncated particle message between ranks");
+    T value;
+    std::memcpy(static_cast<void*>(&value), in.data() + at, sizeof(T));
+    at += sizeof(T);
+    return value;
+}
+
+}  // namespace
+
+ParticleStore CaseRunner::gatheredParticles() const {
+    const Communicator& comm = options_.communicator;
+    const ParticleStore& p = simulation_->particles();
+    std::vector<std::vector<char>> send(comm.size());
+    std::vector<char>& out = send[0];
+    for (std::size_t i = 0; i < simulation_->ownedCount(); ++i) {
+        appendBytes(out, p.id[i]);
+        appendBytes(out, p.position[i]);
+        appendBytes(out, p.velocity[i]);
+        appendBytes(out, p.omega[i]);
+        appendBytes(out, p.force[i]);
+        appendBytes(out, p.radius[i]);
+        appendBytes(out, p.mass[i]);
+        appendBytes(out, p.material[i]);
+    }
+    const std::vector<std::vector<char>> received = comm.exchange(send);
+    ParticleStore all;
+    if (comm.rank() != 0) return all;
+    for (const std::vector<char>& in : received)
+        for (std::size_t at = 0; at < in.size();) {
+            all.id.push_back(takeBytes<std::int64_t>(in, at));
+            all.position.push_back(takeBytes<Vec3>(in, at));
+            all.velocity.push_back(takeBytes<Vec3>(in, at));
+            all.omega.push_back(takeBytes<Vec3>(in, at));
+            all.force.push_back(takeBytes<Vec3>(in, at));
+            all.torque.push_back(Vec3::Zero());
+            all.radius.push_back(takeBytes<double>(in, at));
+            all.mass.push_back(takeBytes<double>(in, at));
+            all.material.push_back(takeBytes<int>(in, at));
+            all.externalForce.push_back(Vec3::Zero());
+        }
+    return all;
+}
+
+void CaseRunner::particlesNear(const Region& region, double margin, std::vector<Vec3>& positions,
+                               std::vector<double>& radii) const {
+    const ParticleStore& p = simulation_->particles();
+    const Vec3 low = region.boundsMin() - Vec3::Constant(margin), high = region.boundsMax() + Vec3::Constant(margin);
+    std::vector<double> mine;
+    for (std::size_t i = 0; i < simulation_->ownedCount(); ++i) {
+        const Vec3& x = p.position[i];
+        if ((x.array() < low.array()).any() || (x.array() > high.array()).any()) continue;
+        mine.insert(mine.end(), {x.x(), x.y(), x.z(), p.radius[i]});
+    }
+    positions.clear();
+    radii.clear();
+    for (const std::vector<double>& part : gatherFromAllRanks(options_.communicator, mine))
+        for (std::size_t k = 0; k + 3 < part.size(); k += 4) {
+            positions.emplace_back(part[k], part[k + 1], part[k + 2]);
+            radii.push_back(part[k + 3]);
+        }
 }
 
 void CaseRunner::finish() {

@@ -589,7 +589,7 @@ std::vector<double> drawPopulation(const InsertionSpec& spec) {
 }
 
 std::size_t performInsertion(Simulation& sim, const InsertionSpec& spec, const std::vector<double>& diameters,
-                             std::size_t first) {
+                             std::size_t first, const ExistingParticles* existing) {
     if (!spec.explicitParticles.empty()) {
         sim.insert(spec.explicitParticles, spec.materialIndex, spec.request.initialVelocity, spec.context);
         return spec.explicitParticles.size();
@@ -598,6 +598,7 @@ std::size_t performInsertion(Simulation& sim, const InsertionSpec& spec, const s
     const ParticleStore& p = sim.particles();
     placement.existing.positions = &p.position;
     placement.existing.radii = &p.radius;
+    if (existing) placement.existing = *existing;
     // Each wave draws its own jitter and site order, reproducibly.
     placement.seed += first;
     const double time = sim.time();

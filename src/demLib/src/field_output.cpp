@@ -42,16 +42,17 @@ FieldOutput::FieldOutput(std::string directory, std::string baseName, double con
         if (continueFromTime >= 0.0 && e.time <= continueFromTime) entries_.push_back(e);
 }
 
-std::string FieldOutput::write(const Simulation& sim) {
-    const ParticleStore& p = sim.particles();
+std::string FieldOutput::write(const Simulation& sim) { return write(sim.particles(), sim.time(), sim.stepCount()); }
+
+std::string FieldOutput::write(const ParticleStore& p, double time, long step) {
     std::ostringstream name;
-    name << baseName_ << "_" << std::setw(9) << std::setfill('0') << sim.stepCount() << ".h5";
+    name << baseName_ << "_" << std::setw(9) << std::setfill('0') << step << ".h5";
     const std::string file = name.str();
     const std::string path = (fs::path(directory_) / file).string();
     {
         Hdf5File f(path + ".writing", Hdf5File::Mode::Create);
-        f.setAttribute("time", sim.time());
-        f.setAttribute("step", static_cast<std::int64_t>(sim.stepCount()));
+        f.setAttribute("time", time);
+        f.setAttribute("step", static_cast<std::int64_t>(step));
         f.sealAttributes();
         f.write("id", p.id);
         f.write("position", p.position);
@@ -64,8 +65,8 @@ std::string FieldOutput::write(const Simulation& sim) {
     }
     if (std::rename((path + ".writing").c_str(), path.c_str()) != 0)
         throw RuntimeError("cannot rename '" + path + ".writing'");
-    while (!entries_.empty() && entries_.back().time >= sim.time()) entries_.pop_back();
-    entries_.push_back({sim.time(), sim.stepCount(), p.size(), file});
+    while (!entries_.empty() && entries_.back().time >= time) entries_.pop_back();
+    entries_.push_back({time, step, p.size(), file});
     writeIndex();
     return path;
 }

@@ -373,8 +373,66 @@ double Simulation::coordinationNumber() const {
 
 std::vector<Vec3> Simulation::wallForces() const {
     std::vector<Vec3> sum(walls_.size(), Vec3::Zero());
-    for (const WallContactRecord& r : wallContacts_.records()) sum[r.wall] -= r.force;
+    const std::size_t owned = ownedCount();
+    for (const WallContactRecord& r : wallContacts_.records())
+        if (static_cast<std::size_t>(r.particle) < owned) sum[r.wall] -= r.force;  // a ghost's is its owner's
     return sum;
+}
+
+RunTotals Simulation::totalsOverRanks() const {
+    RunTotals t;
+    const std::size_t owned = ownedCount();
+    t.particles = owned;
+    t.kineticEnergy = particles_.kineticEnergy(owned);
+    t.touchingPairs = last_.contacts.touchingPairs;
+    t.wallContacts = last_.contacts.wallContacts;
+    t.lost = lost_;
+    t.lostMass = lostMass_;
+    t.wallForces = wallForces();
+    if (!decomposition_) return t;
+    // The kernel counted what it computed: a pair across a slab face on both
+    // of its ranks, and the ghosts' wall contacts.  Those are taken out here
+    // (the positions are the force computation's: a call of step() ends with
+    // a kick), with the kernel's own tests.
+    const auto& offsets = pairs_.offsets();
+    const auto& neighbors = pairs_.neighbors();
+    const ParticleStore& p = particles_;
+    std::size_t twice = 0, ghostWalls = 0;
+    if (forcesValid_) {
+        for (std::size_t i = 0; i + 1 < offsets.size(); ++i)
+            for (int k = offsets[i]; k < offsets[i + 1]; ++k) {
+                const std::size_t j = static_cast<std::size_t>(neighbors[k]);
+                if (j < owned || p.id[i] < p.id[j]) continue;
+                const double radiusSum = p.radius[i] + p.radius[j];
+                if (!((p.position[j] - p.position[i]).squaredNorm() >= radiusSum * radiusSum)) ++twice;
+            }
+        std::vector<WallContact> found;
+        for (const WallContactRecord& r : wallContacts_.records()) {
+            if (static_cast<std::size_t>(r.particle) < owned) continue;
+            found.clear();
+            walls_[r.wall].findContacts(p.position[r.particle], p.radius[r.particle], time_, found);
+            for (const WallContact& c : found)
+                if (c.feature == r.feature && c.overlap > 0.0) {
+                    ++ghostWalls;
+                    break;
+                }
+        }
+    }
+    std::vector<double> local{static_cast<double>(owned), t.kineticEnergy,
+                              static_cast<double>(t.touchingPairs - std::min(twice, t.touchingPairs)),
+                              static_cast<double>(t.wallContacts - std::min(ghostWalls, t.wallContacts)),
+                              static_cast<double>(lost_), lostMass_};
+    for (const Vec3& f : t.wallForces) local.insert(local.end(), {f.x(), f.y(), f.z()});
+    const std::vector<double> sum = sumOverRanksInRankOrder(decomposition_->communicator(), local);
+    t.particles = static_cast<std::size_t>(sum[0]);
+    t.kineticEnergy = sum[1];
+    t.touchingPairs = static_cast<std::size_t>(sum[2]);
+    t.wallContacts = static_cast<std::size_t>(sum[3]);
+    t.lost = static_cast<std::size_t>(sum[4]);
+    t.lostMass = sum[5];
+    for (std::size_t w = 0; w < t.wallForces.size(); ++w)
+        t.wallForces[w] = Vec3(sum[6 + 3 * w], sum[7 + 3 * w], sum[8 + 3 * w]);
+    return t;
 }
 
 void Simulation::removeLostParticles(bool knownNoneLost) {

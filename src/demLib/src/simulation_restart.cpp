@@ -76,7 +76,7 @@ void appendVector(const std::vector<char>& in, std::size_t& at, std::vector<T>& 
     if (at + n * sizeof(T) > in.size()) throw RuntimeError("restart gather: truncated message");
     const std::size_t old = v.size();
     v.resize(old + n);
-    if (n) std::memcpy(v.data() + old, in.data() + at, n * sizeof(T));
+    if (n) std::memcpy(static_cast<void*>(v.data() + old), in.data() + at, n * sizeof(T));
     at += n * sizeof(T);
 }
 

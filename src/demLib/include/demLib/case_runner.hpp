@@ -11,6 +11,7 @@
 #include <string>
 
 #include "demLib/case_setup.hpp"
+#include "demLib/communicator.hpp"
 #include "demLib/field_output.hpp"
 #include "demLib/progress_estimate.hpp"
 
@@ -24,6 +25,11 @@ struct RunOptions {
     // Set to true just before the run changes its first output file (until then a run
     // that stops has left an earlier run's results as they were).
     bool* outputsChanged = nullptr;
+    // The ranks the DEM is spread over (docs/engine.md, "Domain decomposition"):
+    // every rank constructs a CaseRunner with the same case and calls the same
+    // methods; rank 0 writes the outputs and the log (give the other ranks a
+    // stream that discards), all ranks take part in every collective.
+    Communicator communicator = Communicator::serial();
 };
 
 // Throws RuntimeError (a filesystem failure, not an input error) when `file` cannot be
@@ -82,8 +88,18 @@ private:
     // Throws RuntimeError before anything is written when an output cannot be.
     void requireWritableOutputs(const std::filesystem::path& outputDirectory) const;
     // Throws InputError when the particle files asked for would not fit on the disk.
-    void checkFieldOutputVolume(const std::filesystem::path& outputDirectory) const;
+    void checkFieldOutputVolume(const std::filesystem::path& outputDirectory, std::size_t particlesNow) const;
     void progress(bool force);
+    // Rank 0 writes the files (always true without a decomposition).
+    bool writesFiles() const { return options_.communicator.rank() == 0; }
+    // Particles of the run (all ranks; a collective with a decomposition).
+    std::size_t particleCount() const;
+    // The owned particles of all ranks on rank 0, for the particle files.
+    ParticleStore gatheredParticles() const;
+    // The particles of all ranks within `margin` of the region's bounds (every
+    // rank the same list): what a new insertion must not overlap.
+    void particlesNear(const Region& region, double margin, std::vector<Vec3>& positions,
+                       std::vector<double>& radii) const;
 
     CaseSetup setup_;
     std::string caseText_;  // constant/demProperties as read at the start, kept with each restart file

@@ -89,8 +89,11 @@ double expectedParticleCount(const InsertionSpec& spec);
 // Places diameters[first...] in the block's region, avoiding the particles
 // already in `simulation` and its walls, and inserts them.  Returns how many
 // were placed: all of them, or (with a wave interval) those that fit now.
+// existing: the particles the new ones must not overlap (default: those the
+// simulation holds; with a domain decomposition the caller gathers them).
 std::size_t performInsertion(Simulation& simulation, const InsertionSpec& spec,
-                             const std::vector<double>& diameters, std::size_t first = 0);
+                             const std::vector<double>& diameters, std::size_t first = 0,
+                             const ExistingParticles* existing = nullptr);
 // The whole population at once.
 inline std::size_t performInsertion(Simulation& simulation, const InsertionSpec& spec) {
     return performInsertion(simulation, spec, drawPopulation(spec));

@@ -20,6 +20,8 @@ public:
 
     // Writes the current state; returns the HDF5 file's path.
     std::string write(const Simulation& simulation);
+    // The same for particles gathered elsewhere (e.g. from MPI ranks).
+    std::string write(const ParticleStore& particles, double time, long step);
 
     const std::string& indexPath() const { return indexPath_; }
 

@@ -78,6 +78,20 @@ struct LiquidState {
     std::size_t wallBridgeCount = 0;  // particle-wall bridges (option wallBridges)
 };
 
+// What a front end reports of the whole run (summary lines, progress): each
+// particle, pair and wall contact once, whatever the decomposition.
+struct RunTotals {
+    std::size_t particles = 0;
+    double kineticEnergy = 0.0;     // [J]
+    std::size_t touchingPairs = 0;  // particle-particle pairs in contact at the last force computation
+    std::size_t wallContacts = 0;   // particle-wall contacts in contact then
+    std::size_t lost = 0;           // particles lost so far ...
+    double lostMass = 0.0;          // ... and their mass [kg]
+    std::vector<Vec3> wallForces;   // force of the particles on each wall [N]
+    // Mean number of touching contacts per particle.
+    double coordinationNumber() const { return particles == 0 ? 0.0 : 2.0 * touchingPairs / particles; }
+};
+
 class Simulation {
 public:
     // Particles are sorted in space at every spatialSortInterval-th list build.
@@ -154,6 +168,10 @@ public:
     // liquid bridges; walls in the order of walls()) [N].  With a
     // decomposition: of this rank's particles.
     std::vector<Vec3> wallForces() const;
+
+    // The run's totals now.  Collective with a decomposition (sums in rank
+    // order); without one the values of this simulation.
+    RunTotals totalsOverRanks() const;
 
     // Largest time step the settings accept for the particles present, and the
     // limits it is the smallest of.
