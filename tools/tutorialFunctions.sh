@@ -2,7 +2,10 @@
 #
 #   tutorial_parse_args "$@"    sets QUICK (0/1), ROLLING (cdt|epsd2|epsd|none or empty = as in the file),
 #                               THREADS (default 1: on a shared 2-core machine one thread is several
-#                               times faster than two); prints the usage from the caller's header on -help.
+#                               times faster than two; with -np, per rank), NP (MPI ranks of demRun,
+#                               default 1: serial); prints the usage from the caller's header on -help.
+#                               -np N is taken only where the caller set TUTORIAL_NP_OPTION=1 before
+#                               (cases whose DEM is demRun's): elsewhere it is an unknown option
 #                               A case's own flags: the caller's tutorial_case_option FLAG [WORDS...]
 #                               returns 0 when it took FLAG (and sets TUTORIAL_CASE_VALUES to the
 #                               number of words after it that it took as FLAG's value).  A missing or bad value (an option given as the
@@ -27,7 +30,8 @@
 #                               system/controlDict.orig, which are inputs)
 #   tutorial_record             writes constant/runRecord (variant, checksums of the inputs and of the
 #                               generated demProperties and system/controlDict) just before the solver runs
-#   tutorial_run_demRun         demRun (or $DEMRUN) in the case (log.demRun); continues from the newest
+#   tutorial_run_demRun         demRun (or $DEMRUN) in the case (log.demRun), with -np N > 1 as
+#                               diefill_mpirun -np N demRun ... -parallel; continues from the newest
 #                               restart file when there is one (same variant and inputs: tutorial_guard);
 #                               wall time in TUTORIAL_DEM_SECONDS, and TUTORIAL_RUNTIME_ARGS = (-runTime S)
 #                               for the post-processing when the run went from its start in one piece
@@ -62,8 +66,12 @@ _tutorial_value() {
     fi
 }
 
+# The most MPI ranks -np takes: the tutorials' cases hold 700-49 000 particles, and a rank needs a
+# few thousand for its ghost layer to stay below its own particles (docs/parallel.md).
+TUTORIAL_NP_MAX=64
+
 tutorial_parse_args() {
-    QUICK=0; ROLLING=""; THREADS=1
+    QUICK=0; ROLLING=""; THREADS=1; NP=1
     while [ $# -gt 0 ]; do
         case "$1" in
             -quick) QUICK=1 ;;
@@ -82,6 +90,22 @@ tutorial_parse_args() {
                     echo "$(basename "$0"): -threads expects a positive whole number, got '$THREADS'" >&2
                     exit 2 ;;
                 esac ;;
+            -np)
+                if [ "${TUTORIAL_NP_OPTION:-0}" != 1 ]; then
+                    echo "$(basename "$0"): unknown option '$1' (this case does not run on MPI ranks)" >&2
+                    tutorial_usage >&2; exit 2
+                fi
+                _tutorial_value -np "a number of MPI ranks from 1 to $TUTORIAL_NP_MAX" "$@"
+                NP=$2; shift
+                # Checked here, before anything is written into the case (-np 1: serial, as without it).
+                if ! [[ "$NP" =~ ^[1-9][0-9]{0,5}$ ]] || [ "$NP" -gt "$TUTORIAL_NP_MAX" ]; then
+                    echo "$(basename "$0"): -np expects a number of MPI ranks from 1 to $TUTORIAL_NP_MAX (1: serial), got '$NP'" >&2
+                    exit 2
+                fi
+                if [ "$NP" -gt 1 ] && ! command -v mpirun > /dev/null; then
+                    echo "$(basename "$0"): -np $NP needs mpirun (Open MPI), which is not on PATH" >&2
+                    exit 2
+                fi ;;
             -h|-help|--help) tutorial_usage; exit 0 ;;
             *)
                 # A case option with a value sets TUTORIAL_CASE_VALUES=1 (the words it took after the flag).
@@ -232,7 +256,11 @@ tutorial_prepare() {
     ROLLING=$(sed -n -E 's#.*contactModel[^}]*rolling ([a-z0-9]+);.*#\1#p' "$props" | head -1)
     SETTING=$([ "$QUICK" = 1 ] && echo quick || echo full)
     echo "$SETTING" > constant/setting
-    echo "    setting: $SETTING, rolling model: $ROLLING, $THREADS thread(s)"
+    if [ "${NP:-1}" -gt 1 ]; then
+        echo "    setting: $SETTING, rolling model: $ROLLING, $NP MPI ranks x $THREADS thread(s)"
+    else
+        echo "    setting: $SETTING, rolling model: $ROLLING, $THREADS thread(s)"
+    fi
 }
 
 # tutorial_timed_run NAME LOG COMMAND...: runs COMMAND, wall time in TUTORIAL_DEM_SECONDS;
@@ -259,8 +287,17 @@ tutorial_timed_run() {
     echo "    $name: ok (${TUTORIAL_DEM_SECONDS} s, $log)"
 }
 
-# demRun writes log.demRun itself (with its progress lines and ETA)
-_tutorial_demRun() { "${DEMRUN:-demRun}" -case "$PWD" -threads "$THREADS" ${TUTORIAL_RESTART_ARGS[@]+"${TUTORIAL_RESTART_ARGS[@]}"} > "$TUTORIAL_CONSOLE" 2>&1; }
+# demRun writes log.demRun itself (with its progress lines and ETA).  With -np N > 1 on N MPI
+# ranks (-threads per rank); rank 0 takes the case lock under Allrun's (DIEFILL_CASE_LOCK passed
+# on with -x), writes the log and the results; stdin is not handed to rank 0.
+_tutorial_demRun() {
+    if [ "${NP:-1}" -gt 1 ]; then
+        diefill_mpirun -x DIEFILL_CASE_LOCK -np "$NP" "${DEMRUN:-demRun}" -case "$PWD" -parallel -threads "$THREADS" \
+            ${TUTORIAL_RESTART_ARGS[@]+"${TUTORIAL_RESTART_ARGS[@]}"} < /dev/null > "$TUTORIAL_CONSOLE" 2>&1
+    else
+        "${DEMRUN:-demRun}" -case "$PWD" -threads "$THREADS" ${TUTORIAL_RESTART_ARGS[@]+"${TUTORIAL_RESTART_ARGS[@]}"} > "$TUTORIAL_CONSOLE" 2>&1
+    fi
+}
 _tutorial_diefillFoam() { diefillFoam >> log.diefillFoam 2>&1; }
 
 # A stopped run (or a finished one: then only the post-processing runs again) goes on from its
@@ -275,7 +312,7 @@ tutorial_run_demRun() {
     fi
     tutorial_record
     TUTORIAL_CONSOLE=$(mktemp)      # outside the case: the console output, shown if demRun is refused
-    tutorial_timed_run demRun log.demRun _tutorial_demRun
+    tutorial_timed_run "demRun$([ "${NP:-1}" -gt 1 ] && echo " on $NP MPI ranks")" log.demRun _tutorial_demRun
     TUTORIAL_RUNTIME_ARGS=()
     [ -n "${TUTORIAL_RESTART_ARGS[*]}" ] || TUTORIAL_RUNTIME_ARGS=(-runTime "$TUTORIAL_DEM_SECONDS")
 }
