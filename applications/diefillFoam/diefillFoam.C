@@ -82,7 +82,7 @@ int main(int argc, char *argv[])
     if (coupling.restartForces())
     {
         Info<< "Coupling: fluid forces on the particles from "
-            << runTime.timeName()/"uniform/particleForces" << endl;
+            << coupling.restartForcesFile() << endl;
     }
     else
     {

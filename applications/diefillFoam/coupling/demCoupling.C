@@ -6,19 +6,26 @@
 #include "mathematicalConstants.H"
 #include "sigFpe.H"
 #include "vectorIOField.H"
+#include "treeDataCell.H"
 #include "clockValue.H"
 
 #include "demLib/case_lock.hpp"
 #include "demLib/case_runner.hpp"
 #include "demLib/case_setup.hpp"
+#include "demLib/config.hpp"
 #include "demLib/error.hpp"
+#include "demLib/hdf5_file.hpp"
 #include "demLib/version.hpp"
+#if DEMLIB_HAS_MPI
+#include "demLib/communicator_mpi.hpp"
+#endif
 
 #include <cmath>
 #include <cstring>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
+#include <unordered_map>
 
 // Defined in demLib (src/demLib/src/version.cpp): the version of the library
 // actually loaded, as opposed to dem::versionString of the headers.
@@ -57,6 +64,29 @@ Foam::Field<Type> Foam::diefill::demCoupling::averageToParticles
         {
             result[i] += weights_[i][k]*cellValues[cells_[i][k]];
         }
+    }
+    if (decomposed_)
+    {
+        // Each visitor's share back to its owner, summed in rank order
+        const label width = pTraits<Type>::nComponents;
+        std::vector<double> shares(result.size()*width);
+        forAll(result, v)
+        {
+            for (label c = 0; c < width; ++c)
+            {
+                shares[v*width + c] = component(result[v], c);
+            }
+        }
+        const std::vector<double> sums = routing_->sumToOwners(shares, width);
+        Field<Type> owned(nOwned(), Zero);
+        forAll(owned, i)
+        {
+            for (label c = 0; c < width; ++c)
+            {
+                setComponent(owned[i], c) = sums[i*width + c];
+            }
+        }
+        return owned;
     }
     // Master sums and sends back: every rank gets the same bits.
     Pstream::listCombineGather(result, plusEqOp<Type>());
@@ -164,6 +194,7 @@ Foam::diefill::demCoupling::demCoupling
     smoothingLength_(dict_.getOrDefault<scalar>("smoothingLength", 0)),
     g_("g", dimAcceleration, Zero),
     coarseGrainFactor_(1),
+    decomposed_(Pstream::parRun()),
     K_(),
     nLost_(0),
     restartForces_(false)
@@ -327,17 +358,38 @@ Foam::diefill::demCoupling::demCoupling
             << coarseGrainFactor_ << endl;
     }
 
-    // Each rank runs the same DEM; only the master's output goes to the case
-    // output folder, the others write theirs below their processor folder.
-    if (Pstream::parRun() && !Pstream::master())
-    {
-        setup.output.directory =
-            "processor" + std::to_string(Pstream::myProcNo()) + "/"
-          + setup.output.directory;
-    }
-
+    demRestartDir_ = caseDir/fileName(setup.output.directory)/"restart";
     dem::RunOptions options;
     options.progressInterval = 0;
+    if (decomposed_)
+    {
+        // The DEM over the same ranks as the air, on a communicator of its
+        // own (its messages never meet OpenFOAM's); rank 0 writes its output.
+#if DEMLIB_HAS_MPI
+        MPI_Comm demComm = MPI_COMM_NULL;
+        MPI_Comm_dup(MPI_COMM_WORLD, &demComm);
+        options.communicator = dem::communicatorFromMpi(demComm);
+#else
+        FatalErrorInFunction
+            << "-parallel needs demLib built with MPI (install/include/demLib/"
+            << "config.hpp says it was not): rebuild with ./Allwmake"
+            << exit(FatalError);
+#endif
+        // OpenFOAM builds the tet decomposition and the cell search tree on
+        // first use, with collectives: a rank with no particle in its cells
+        // would never get there and the others would wait for it (the
+        // deadlock of the replicated DEM).  Built here, on every rank.
+        (void)mesh_.tetBasePtIs();
+        (void)mesh_.cellTree();
+        routing_.reset
+        (
+            new particleRouting
+            (
+                options.communicator,
+                mesh_.nCells() ? treeBoundBox(mesh_.points()) : treeBoundBox(boundBox::invertedBox)
+            )
+        );
+    }
     const scalar startTime = mesh_.time().startTime().value();
     if (startTime <= 0)
     {
@@ -439,7 +491,11 @@ Foam::diefill::demCoupling::demCoupling
             IOobject::MUST_READ,
             IOobject::NO_WRITE
         );
-        if (forcesHeader.typeHeaderOk<vectorIOField>(true))
+        if (decomposed_)
+        {
+            readForcesById(options.restartFrom + ".forces");
+        }
+        else if (forcesHeader.typeHeaderOk<vectorIOField>(true))
         {
             const vectorIOField forces(forcesHeader);
             auto& particles = runner_->simulation().particles();
@@ -456,6 +512,7 @@ Foam::diefill::demCoupling::demCoupling
                     dem::Vec3(forces[i].x(), forces[i].y(), forces[i].z());
             }
             restartForces_ = true;
+            restartForcesFile_ = forcesHeader.objectPath();
         }
     }
 
@@ -485,9 +542,167 @@ Foam::diefill::demCoupling::~demCoupling()
 
 // * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
 
+Foam::label Foam::diefill::demCoupling::nOwned() const
+{
+    return runner_->simulation().ownedCount();
+}
+
+
 Foam::label Foam::diefill::demCoupling::nParticles() const
 {
-    return runner_->simulation().particles().size();
+    return decomposed_ ? returnReduce(nOwned(), sumOp<label>()) : nOwned();
+}
+
+
+std::string Foam::diefill::demCoupling::forcesFileOfNow() const
+{
+    const label step =
+        label(std::round(mesh_.time().value()/runner_->simulation().timeStep()));
+    std::ostringstream name;
+    name<< "restart_" << std::setw(9) << std::setfill('0') << step << ".h5.forces";
+    return demRestartDir_ + "/" + name.str();
+}
+
+
+void Foam::diefill::demCoupling::writeForcesById() const
+{
+    // Every rank's (id, force) to rank 0, which writes them in rank order
+    const auto& particles = runner_->simulation().particles();
+    const dem::Communicator& comm = runner_->simulation().decomposition()->communicator();
+    std::vector<std::vector<char>> send(comm.size());
+    for (label i = 0; i < nOwned(); ++i)
+    {
+        const double record[4] =
+        {
+            double(particles.id[i]),
+            particles.externalForce[i].x(),
+            particles.externalForce[i].y(),
+            particles.externalForce[i].z()
+        };
+        const char* bytes = reinterpret_cast<const char*>(record);
+        send[0].insert(send[0].end(), bytes, bytes + sizeof record);
+    }
+    const auto received = comm.exchange(send);
+    std::string failure;
+    if (comm.rank() == 0)
+    {
+        std::vector<std::int64_t> ids;
+        std::vector<dem::Vec3> forces;
+        for (const auto& part : received)
+        {
+            std::vector<double> d(part.size()/sizeof(double));
+            if (!d.empty()) std::memcpy(d.data(), part.data(), part.size());
+            for (std::size_t k = 0; k + 3 < d.size(); k += 4)
+            {
+                ids.push_back(std::int64_t(d[k]));
+                forces.emplace_back(d[k + 1], d[k + 2], d[k + 3]);
+            }
+        }
+        const std::string file = forcesFileOfNow();
+        try
+        {
+            {
+                dem::Hdf5File f(file + ".writing", dem::Hdf5File::Mode::Create);
+                f.setAttribute("time", mesh_.time().value());
+                f.sealAttributes();
+                f.write("id", ids);
+                f.write("force", forces);
+            }
+            if (std::rename((file + ".writing").c_str(), file.c_str()) != 0)
+            {
+                failure = "cannot rename " + file + ".writing";
+            }
+        }
+        catch (const std::exception& e)
+        {
+            failure = e.what();
+        }
+    }
+    if (comm.anyTrue(!failure.empty()))
+    {
+        FatalErrorInFunction
+            << "Writing the particle forces failed"
+            << (failure.empty() ? std::string(" on rank 0") : ": " + failure).c_str()
+            << exit(FatalError);
+    }
+}
+
+
+void Foam::diefill::demCoupling::readForcesById(const std::string& file)
+{
+    // Rank 0 reads and hands every rank all of them (once, at the start);
+    // each takes its own particles' by id.
+    const dem::Communicator& comm = runner_->simulation().decomposition()->communicator();
+    std::vector<char> all;
+    std::string failure;
+    bool present = false;
+    if (comm.rank() == 0 && isFile(file))
+    {
+        present = true;
+        try
+        {
+            dem::Hdf5File f(file, dem::Hdf5File::Mode::Read);
+            f.checkAttributes();
+            const std::vector<std::int64_t> ids = f.readInt64("id");
+            const std::vector<dem::Vec3> forces = f.readVec3("force");
+            if (ids.size() != forces.size())
+            {
+                failure = file + ": " + std::to_string(ids.size()) + " ids but "
+                    + std::to_string(forces.size()) + " forces";
+            }
+            for (std::size_t k = 0; k < ids.size() && failure.empty(); ++k)
+            {
+                const double record[4] = {double(ids[k]), forces[k].x(), forces[k].y(), forces[k].z()};
+                const char* bytes = reinterpret_cast<const char*>(record);
+                all.insert(all.end(), bytes, bytes + sizeof record);
+            }
+        }
+        catch (const std::exception& e)
+        {
+            failure = e.what();
+        }
+    }
+    if (comm.anyTrue(!failure.empty()))
+    {
+        FatalErrorInFunction
+            << "Reading the particle forces " << file.c_str() << " failed"
+            << (failure.empty() ? std::string(" on rank 0") : ": " + failure).c_str()
+            << exit(FatalError);
+    }
+    if (!comm.anyTrue(present))
+    {
+        return;  // computed from the air instead
+    }
+    const auto received = comm.exchange(std::vector<std::vector<char>>(comm.size(), comm.rank() == 0 ? all : std::vector<char>()));
+    std::vector<double> d(received[0].size()/sizeof(double));
+    if (!d.empty()) std::memcpy(d.data(), received[0].data(), received[0].size());
+    std::unordered_map<std::int64_t, vector> byId;
+    for (std::size_t k = 0; k + 3 < d.size(); k += 4)
+    {
+        byId[std::int64_t(d[k])] = vector(d[k + 1], d[k + 2], d[k + 3]);
+    }
+    auto& particles = runner_->simulation().particles();
+    label missing = 0;
+    for (label i = 0; i < nOwned(); ++i)
+    {
+        const auto it = byId.find(particles.id[i]);
+        if (it == byId.end())
+        {
+            ++missing;
+            continue;
+        }
+        particles.externalForce[i] = dem::Vec3(it->second.x(), it->second.y(), it->second.z());
+    }
+    reduce(missing, sumOp<label>());
+    if (missing || label(byId.size()) != nParticles())
+    {
+        FatalErrorInFunction
+            << file.c_str() << " holds the forces of " << byId.size()
+            << " particles, the DEM restart file " << nParticles() << " ("
+            << missing << " without a force)" << exit(FatalError);
+    }
+    restartForces_ = true;
+    restartForcesFile_ = file;
 }
 
 
@@ -512,7 +727,30 @@ void Foam::diefill::demCoupling::updateVoidFraction()
 {
     const clockValue started(true);
     const auto& particles = runner_->simulation().particles();
-    const label n = particles.size();
+    const label owned = nOwned();
+
+    // The particles spread over this rank's cells: all of them serially;
+    // decomposed, the visitors routed here by their owners.
+    std::vector<point> centres;
+    std::vector<scalar> radii;
+    for (label i = 0; i < owned; ++i)
+    {
+        const auto& x = particles.position[i];
+        centres.emplace_back(x.x(), x.y(), x.z());
+        radii.push_back(particles.radius[i]);
+    }
+    if (decomposed_)
+    {
+        routing_->route(centres, radii);
+        centres.resize(routing_->nVisitors());
+        radii.resize(routing_->nVisitors());
+        for (label v = 0; v < routing_->nVisitors(); ++v)
+        {
+            centres[v] = routing_->visitorCentre(v);
+            radii[v] = routing_->visitorRadius(v);
+        }
+    }
+    const label n = label(centres.size());
 
     cells_.setSize(n);
     weights_.setSize(n);
@@ -524,24 +762,29 @@ void Foam::diefill::demCoupling::updateVoidFraction()
     label hint = -1;
     for (label i = 0; i < n; ++i)
     {
-        const auto& x = particles.position[i];
         cells_[i].clear();
         weights_[i].clear();
-        voidFraction_->distribute
-        (
-            point(x.x(), x.y(), x.z()),
-            particles.radius[i],
-            hint,
-            cells_[i],
-            weights_[i]
-        );
+        voidFraction_->distribute(centres[i], radii[i], hint, cells_[i], weights_[i]);
         found[i] = sum(weights_[i]);
     }
 
     // Normalise over all ranks: a particle partly outside the mesh (in a
     // wall) keeps its whole volume inside.
-    Pstream::listCombineGather(found, plusEqOp<scalar>());
-    Pstream::listCombineScatter(found);
+    std::vector<double> ownerTotal;  // decomposed: per particle this rank steps
+    if (decomposed_)
+    {
+        ownerTotal = routing_->sumToOwners(std::vector<double>(found.begin(), found.end()), 1);
+        const std::vector<double> back = routing_->sendToVisitors(ownerTotal, 1);
+        forAll(found, v)
+        {
+            found[v] = back[v];
+        }
+    }
+    else
+    {
+        Pstream::listCombineGather(found, plusEqOp<scalar>());
+        Pstream::listCombineScatter(found);
+    }
 
     scalarField solidFraction(mesh_.nCells(), Zero);
     scalar particleVolume = 0;
@@ -550,12 +793,12 @@ void Foam::diefill::demCoupling::updateVoidFraction()
     {
         if (found[i] <= 0)
         {
-            ++nLost_;
+            // Counted by the owner (a visitor may hold none of its cells here)
+            if (!decomposed_) ++nLost_;
             continue;
         }
-        const scalar Vp =
-            4.0/3.0*constant::mathematical::pi*pow3(particles.radius[i]);
-        particleVolume += Vp;
+        const scalar Vp = 4.0/3.0*constant::mathematical::pi*pow3(radii[i]);
+        if (!decomposed_) particleVolume += Vp;
         forAll(cells_[i], k)
         {
             weights_[i][k] /= found[i];
@@ -601,11 +844,23 @@ void Foam::diefill::demCoupling::updateVoidFraction()
     }
     alpha_.correctBoundaryConditions();
 
+    if (decomposed_)
+    {
+        // The owners count their particles found in no cell of any rank
+        for (label i = 0; i < owned; ++i)
+        {
+            if (ownerTotal[i] <= 0) ++nLost_;
+            else particleVolume += 4.0/3.0*constant::mathematical::pi*pow3(particles.radius[i]);
+        }
+        reduce(nLost_, sumOp<label>());
+        reduce(particleVolume, sumOp<scalar>());
+    }
+
     // Volume conservation check: what the cells hold vs the particles
     const scalar cellVolume = gSum(solidFraction*mesh_.V());
     reduce(nClamped, sumOp<label>());
 
-    Info<< "Coupling: " << n << " particles (" << nLost_
+    Info<< "Coupling: " << nParticles() << " particles (" << nLost_
         << " outside the mesh), solid volume: particles " << particleVolume
         << " m3, cells " << cellVolume << " m3; void fraction min "
         << gMin(alpha) << " mean " << gSum(alpha*mesh_.V())/gSum(mesh_.V())
@@ -620,8 +875,7 @@ void Foam::diefill::demCoupling::updateExchange
     volVectorField& KUp
 )
 {
-    const auto& particles = runner_->simulation().particles();
-    const label n = particles.size();
+    const label n = nOwned();
 
     const vectorField Uf(averageToParticles<vector>(U_.primitiveField()));
     const scalarField alphaP(averageToParticles<scalar>(alpha_.primitiveField()));
@@ -632,23 +886,47 @@ void Foam::diefill::demCoupling::updateExchange
     KspIn = Zero;
     KUpIn = Zero;
 
+    // K_i and v_i of every particle this rank steps; serially they go to its
+    // cells at once, decomposed to the ranks it visits (below)
+    std::vector<double> coefficients;
     for (label i = 0; i < n; ++i)
     {
         K_[i] = 0;
-        if (alphaP[i] <= 0)
+        vector velocity(Zero);
+        if (alphaP[i] > 0)  // else outside the mesh
         {
-            continue;  // outside the mesh
+            const particleFluidState s(state(i, Uf[i], alphaP[i], Zero));
+            for (const particleForce& f : forces_)
+            {
+                K_[i] += f.implicitCoeff(s);
+            }
+            velocity = s.particleVelocity;
         }
-        const particleFluidState s(state(i, Uf[i], alphaP[i], Zero));
-        for (const particleForce& f : forces_)
+        if (decomposed_)
         {
-            K_[i] += f.implicitCoeff(s);
+            coefficients.insert(coefficients.end(), {K_[i], velocity.x(), velocity.y(), velocity.z()});
+            continue;
         }
         forAll(cells_[i], k)
         {
             const label celli = cells_[i][k];
             KspIn[celli] += weights_[i][k]*K_[i];
-            KUpIn[celli] += weights_[i][k]*K_[i]*s.particleVelocity;
+            KUpIn[celli] += weights_[i][k]*K_[i]*velocity;
+        }
+    }
+    if (decomposed_)
+    {
+        const std::vector<double> visiting = routing_->sendToVisitors(coefficients, 4);
+        forAll(cells_, v)
+        {
+            const scalar K = visiting[4*v];
+            const vector velocity(visiting[4*v + 1], visiting[4*v + 2], visiting[4*v + 3]);
+            forAll(cells_[v], k)
+            {
+                const label celli = cells_[v][k];
+                KspIn[celli] += weights_[v][k]*K;
+                KUpIn[celli] += weights_[v][k]*K*velocity;
+            }
         }
     }
 
@@ -667,7 +945,7 @@ void Foam::diefill::demCoupling::updateParticleForces
 )
 {
     auto& particles = runner_->simulation().particles();
-    const label n = particles.size();
+    const label n = nOwned();
 
     const vectorField Uf(averageToParticles<vector>(U_.primitiveField()));
     const scalarField alphaP(averageToParticles<scalar>(alpha_.primitiveField()));
@@ -698,9 +976,17 @@ void Foam::diefill::demCoupling::updateParticleForces
         const auto& v = particles.velocity[i];
         meanVelocity += vector(v.x(), v.y(), v.z());
     }
-    if (n > 0)
+    label total = n;
+    if (decomposed_)
     {
-        meanVelocity /= n;
+        reduce(dragOnParticles, sumOp<vector>());
+        reduce(explicitOnParticles, sumOp<vector>());
+        reduce(meanVelocity, sumOp<vector>());
+        reduce(total, sumOp<label>());
+    }
+    if (total > 0)
+    {
+        meanVelocity /= total;
     }
 
     // What the air lost through its exchange terms, from the fields alone
@@ -721,19 +1007,21 @@ void Foam::diefill::demCoupling::updateParticleForces
 void Foam::diefill::demCoupling::write() const
 {
     const auto& particles = runner_->simulation().particles();
-    vectorIOField forces
+    const IOobject header
     (
-        IOobject
-        (
-            "particleForces",
-            mesh_.time().timeName(),
-            "uniform",
-            mesh_,
-            IOobject::NO_READ,
-            IOobject::NO_WRITE
-        ),
-        label(particles.size())
+        "particleForces",
+        mesh_.time().timeName(),
+        "uniform",
+        mesh_,
+        IOobject::NO_READ,
+        IOobject::NO_WRITE
     );
+    if (decomposed_)
+    {
+        writeForcesById();
+        return;
+    }
+    vectorIOField forces(header, nOwned());
     forAll(forces, i)
     {
         const auto& f = particles.externalForce[i];

@@ -162,12 +162,26 @@ void Simulation::insert(const std::vector<InsertedParticle>& inserted, int mater
     const double density = materials_[materialIndex].density;
     if (decomposition_) {
         // Every rank is given the same particles and numbers them alike; each
-        // keeps the ones in its slab, after its owned ones (ghosts go first).
-        decomposition_->dropGhosts(particles_, pairs_, wallContacts_);
+        // keeps the ones in its slab, after its owned ones and before the
+        // ghosts (moved behind them), so that the lists, bridges included,
+        // stay as they are until the next step lists again (as serially).
+        const std::size_t owned = ownedCount(), before = particles_.size();
         for (const InsertedParticle& q : inserted) {
             const std::int64_t id = nextId_++;
             if (decomposition_->owns(q.position))
                 particles_.add(id, q.position, velocity, q.radius, density, materialIndex);
+        }
+        const std::size_t added = particles_.size() - before;
+        if (added > 0 && before > owned) {
+            std::vector<int> order;  // new index -> old index
+            order.reserve(particles_.size());
+            for (std::size_t i = 0; i < owned; ++i) order.push_back(static_cast<int>(i));
+            for (std::size_t k = 0; k < added; ++k) order.push_back(static_cast<int>(before + k));
+            for (std::size_t g = owned; g < before; ++g) order.push_back(static_cast<int>(g));
+            const std::vector<int> oldToNew = inversePermutation(order);
+            particles_.permute(order);
+            pairs_.remap(oldToNew);
+            wallContacts_.remap(oldToNew);
         }
         forcesValid_ = false;
         return;
