@@ -2,10 +2,10 @@
 #
 #   tutorial_parse_args "$@"    sets QUICK (0/1), ROLLING (cdt|epsd2|epsd|none or empty = as in the file),
 #                               THREADS (default 1: on a shared 2-core machine one thread is several
-#                               times faster than two; with -np, per rank), NP (MPI ranks of demRun,
-#                               default 1: serial); prints the usage from the caller's header on -help.
-#                               -np N is taken only where the caller set TUTORIAL_NP_OPTION=1 before
-#                               (cases whose DEM is demRun's): elsewhere it is an unknown option
+#                               times faster than two; with -np, per rank), NP (MPI ranks of demRun or
+#                               diefillFoam, default 1: serial); prints the usage from the caller's
+#                               header on -help.  -np N is taken only where the caller set
+#                               TUTORIAL_NP_OPTION=1 before: elsewhere it is an unknown option
 #                               A case's own flags: the caller's tutorial_case_option FLAG [WORDS...]
 #                               returns 0 when it took FLAG (and sets TUTORIAL_CASE_VALUES to the
 #                               number of words after it that it took as FLAG's value).  A missing or bad value (an option given as the
@@ -143,7 +143,8 @@ _tutorial_md5() { md5sum < "$1" | cut -d' ' -f1; }
 _tutorial_recorded() { sed -n "s/^$1 //p" constant/runRecord 2> /dev/null; }
 
 # Files Allrun (or what it runs: writeAirMesh, the solver's start) writes into constant/ and system/.
-TUTORIAL_AIR_DICTS=(system/blockMeshDict system/topoSetDict system/topoSetDict.aeration system/createPatchDict)
+TUTORIAL_AIR_DICTS=(system/blockMeshDict system/topoSetDict system/topoSetDict.aeration system/createPatchDict
+                    system/decomposeParDict)
 TUTORIAL_GENERATED=(constant/demProperties system/controlDict constant/setting constant/air constant/runRecord
                     "${TUTORIAL_AIR_DICTS[@]}")
 
@@ -298,7 +299,42 @@ _tutorial_demRun() {
         "${DEMRUN:-demRun}" -case "$PWD" -threads "$THREADS" ${TUTORIAL_RESTART_ARGS[@]+"${TUTORIAL_RESTART_ARGS[@]}"} > "$TUTORIAL_CONSOLE" 2>&1
     fi
 }
-_tutorial_diefillFoam() { diefillFoam >> log.diefillFoam 2>&1; }
+# With -np N > 1: the air decomposed by decomposePar and the DEM by demLib, on N MPI ranks
+# (docs/coupling.md, "Parallel"); rank 0 takes the case lock under Allrun's.
+_tutorial_diefillFoam() {
+    if [ "${NP:-1}" -gt 1 ]; then
+        diefill_mpirun -x DIEFILL_CASE_LOCK -x OMP_NUM_THREADS -np "$NP" diefillFoam -parallel < /dev/null \
+            >> log.diefillFoam 2>&1
+    else
+        diefillFoam >> log.diefillFoam 2>&1
+    fi
+}
+
+# The air of a run on -np N ranks: N slabs along x (the shoe's motion; the DEM cuts its own, by
+# particle count), decomposed at the start or, continuing a serial run, at its newest time.  A run
+# decomposed on another count continues on that one (the processor folders hold its air).
+_tutorial_decompose() {
+    local continued=$1 have=0 dir
+    for dir in processor[0-9]*; do [ ! -d "$dir" ] || have=$((have + 1)); done
+    if [ "$have" -gt 0 ]; then
+        [ "$have" = "$NP" ] && return 0
+        echo "$(basename "$0"): this run's air is decomposed on $have ranks (processor*/): continue it with" \
+             "-np $have (or reconstructPar, remove processor*, and continue with -np $NP); nothing done" >&2
+        exit 2
+    fi
+    cat > system/decomposeParDict <<EOF_DICT
+FoamFile { version 2.0; format ascii; class dictionary; object decomposeParDict; }
+// Written by Allrun -np $NP: the air in $NP slabs along x.
+numberOfSubdomains $NP;
+method          simple;
+coeffs          { n ($NP 1 1); }
+EOF_DICT
+    if ! decomposePar -force $([ "$continued" = 1 ] && echo -latestTime) > log.decomposePar 2>&1; then
+        echo "$(basename "$PWD"): decomposePar failed; last lines of log.decomposePar:" >&2
+        tail -n 20 log.decomposePar >&2
+        exit 1
+    fi
+}
 
 # A stopped run (or a finished one: then only the post-processing runs again) goes on from its
 # newest restart file; tutorial_guard has made sure it is this variant's, with these inputs.
@@ -317,8 +353,11 @@ tutorial_run_demRun() {
     [ -n "${TUTORIAL_RESTART_ARGS[*]}" ] || TUTORIAL_RUNTIME_ARGS=(-runTime "$TUTORIAL_DEM_SECONDS")
 }
 
-# Time folders of the air after 0, in order
-tutorial_air_times() { ls -d [0-9]* 2>/dev/null | grep -E '^[0-9]+(\.[0-9]+)?(e[+-]?[0-9]+)?$' | grep -v '^0$' | sort -g; }
+# Time folders of the air after 0, in order (a decomposed run's in processor0/)
+tutorial_air_times() {
+    { ls -d [0-9]* 2>/dev/null; [ ! -d processor0 ] || (cd processor0 && ls -d [0-9]* 2>/dev/null); } \
+        | grep -E '^[0-9]+(\.[0-9]+)?(e[+-]?[0-9]+)?$' | grep -v '^0$' | sort -gu
+}
 
 tutorial_prepare_air() {
     local scale=$1 tool
@@ -348,9 +387,17 @@ tutorial_prepare_air() {
 
 tutorial_run_diefillFoam() {
     local continued=0
-    if [ -d dem/restart ] && [ -n "$(tutorial_air_times)" ]; then continued=1; else rm -rf dem; fi
+    if [ -d dem/restart ] && [ -n "$(tutorial_air_times)" ]; then continued=1; else rm -rf dem processor[0-9]*; fi
+    [ "${NP:-1}" -le 1 ] || _tutorial_decompose "$continued"
     tutorial_record
-    OMP_NUM_THREADS=$THREADS tutorial_timed_run diefillFoam log.diefillFoam _tutorial_diefillFoam
+    OMP_NUM_THREADS=$THREADS tutorial_timed_run "diefillFoam$([ "${NP:-1}" -gt 1 ] && echo " on $NP MPI ranks")" \
+        log.diefillFoam _tutorial_diefillFoam
+    # The air fields of every written time in the case folder too (ParaView, a serial continuation)
+    if [ "${NP:-1}" -gt 1 ] && ! reconstructPar -newTimes > log.reconstructPar 2>&1; then
+        echo "$(basename "$PWD"): reconstructPar failed; last lines of log.reconstructPar:" >&2
+        tail -n 20 log.reconstructPar >&2
+        exit 1
+    fi
     TUTORIAL_RUNTIME_ARGS=()
     [ "$continued" = 1 ] || TUTORIAL_RUNTIME_ARGS=(-runTime "$TUTORIAL_DEM_SECONDS")
 }

@@ -706,6 +706,7 @@ void CaseRunner::advanceTo(double time) {
         }
         const std::size_t before = particleCount();
         s.step(steps);
+        logRecuts();
         requireParticlesKept(before);
         performDueInsertions();
         performDueWetting();
@@ -733,6 +734,19 @@ void CaseRunner::requireParticlesKept(std::size_t before) {
       << setup_.settings.gravity.norm() << " m/s^2), the insertions' 'velocity', the materials' 'density' and "
          "'youngsModulus', and 'simulation/domain'";
     throw InputError(m.str());
+}
+
+void CaseRunner::logRecuts() {
+    const GhostExchange* d = simulation_->decomposition();
+    if (!d || d->recutCount() == recutsLogged_) return;
+    // The report holds the run's values (reductions), the same on every rank.
+    const GhostExchange::RebalanceReport& r = d->lastRecut();
+    log_ << "DEM slabs re-cut at t = " << simulation_->time() << " s (" << d->recutCount() - recutsLogged_
+         << " since the last line): owned particles max " << r.maxOwned << " / mean " << r.meanOwned
+         << " = " << r.imbalance << " before; cuts along " << "xyz"[d->slabs().axis()] << " now at";
+    for (double c : r.cuts) log_ << " " << c;
+    log_ << " m" << std::endl;
+    recutsLogged_ = d->recutCount();
 }
 
 std::size_t CaseRunner::particleCount() const {

@@ -175,6 +175,7 @@ GhostExchange::RebalanceReport GhostExchange::rebalanceIfNeeded(const ParticleSt
     report.recut = recut;
     report.cuts = slabs_.interiorCuts();
     lastRebalance_ = report;
+    if (recut) lastRecut_ = report;
     return report;
 }
 

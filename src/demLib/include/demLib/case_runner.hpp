@@ -90,6 +90,8 @@ private:
     // Throws InputError when the particle files asked for would not fit on the disk.
     void checkFieldOutputVolume(const std::filesystem::path& outputDirectory, std::size_t particlesNow) const;
     void progress(bool force);
+    // With a decomposition: a log line for each re-cut of the DEM slabs since the last.
+    void logRecuts();
     // Rank 0 writes the files (always true without a decomposition).
     bool writesFiles() const { return options_.communicator.rank() == 0; }
     // Particles of the run (all ranks; a collective with a decomposition).
@@ -119,6 +121,7 @@ private:
     double startTime_ = 0.0;
     std::chrono::steady_clock::time_point wallStart_, lastProgress_;
     long stepsAtStart_ = 0;
+    std::size_t recutsLogged_ = 0;  // the DEM slabs' re-cuts said in the log so far
     long firstParticlesStep_ = -1;  // the step at which this run first held particles
     ProgressEstimate estimate_{0.0, 0.0};  // the ETA, from the pace of the last minutes
 };

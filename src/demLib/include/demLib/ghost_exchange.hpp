@@ -122,6 +122,8 @@ public:
     // Re-cuts so far, and the report of the latest rebalanceIfNeeded call.
     std::size_t recutCount() const { return recuts_; }
     const RebalanceReport& lastRebalance() const { return lastRebalance_; }
+    // The report of the latest call that re-cut (front ends log it).
+    const RebalanceReport& lastRecut() const { return lastRecut_; }
     // Particles this rank has sent to other ranks by migrate() so far.
     std::size_t migratedCount() const { return migrated_; }
 
@@ -137,6 +139,7 @@ private:
     double rebalanceThreshold_ = defaultRebalanceThreshold;
     std::size_t recuts_ = 0;
     RebalanceReport lastRebalance_;
+    RebalanceReport lastRecut_;
 };
 
 }  // namespace dem
