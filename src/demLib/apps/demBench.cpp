@@ -17,7 +17,17 @@
 //       (key value) that bench/run parses.  -ranks R: the bed on R ranks of the
 //       domain decomposition that are threads of this process (each rank its
 //       own slab and arrays, docs/engine.md), instead of N OpenMP threads on one
-//       simulation; dry beds only (the decomposition has no capillary model).
+//       simulation (wet beds share their water over the ranks).
+//       mpirun -np R demBench time ... -parallel: the same on R MPI ranks, one
+//       thread each.  Both print, besides the rate: ghost_fraction (ghosts /
+//       owned over all ranks, mean of the samples), bytes_per_particle_step
+//       (payload all ranks sent over the timed steps / particle-steps; the
+//       communicator's counters), communication_seconds (rank 0's time inside
+//       collectives; _max the largest rank's; communication_share = rank 0's /
+//       the timed wall time), imbalance_mean/_max/_end (max/mean owned), the
+//       slab re-cuts of the load balance and the particles migrated.  The slabs
+//       start at equal counts; the engine re-cuts them at list builds when
+//       max/mean owned exceeds 1.10.
 //
 //   demBench copies -case DIR -bed FILE -steps K [-copies C]
 //       C independent simulations of the bed at once, each on its own thread
@@ -59,6 +69,10 @@
 #include "demLib/error.hpp"
 #include "demLib/ghost_exchange.hpp"
 #include "demLib/simulation.hpp"
+
+#if DEMLIB_HAS_MPI
+#include "demLib/communicator_mpi.hpp"
+#endif
 
 #include <cstring>
 
@@ -425,62 +439,151 @@ dem::SlabDecomposition equalCountSlabs(const std::vector<dem::InsertedParticle>&
     return dem::SlabDecomposition(ranks, axis, cuts);
 }
 
-// timeSteps with -ranks R: the same protocol on R thread ranks of the domain
-// decomposition; rank 0 times each call of steps up to a barrier (timedSteps).
-int timeStepsOnRanks(const Options& o, int ranks) {
-    const std::string caseDir = o.get("case");
-    const dem::CaseSetup setup = dem::readCaseSetup(caseDir);
-    if (setup.waterContent > 0.0)
-        throw dem::InputError("demBench time: -ranks runs dry beds only (" + setup.propertiesFile +
-                              " sets waterContent; the domain decomposition has no capillary model)");
+// What one timed run of the domain decomposition gave (rank 0's copy).
+struct RankTiming {
+    double seconds = 0.0, kineticEnergy = 0.0;
+    long builds = 0;
+    std::int64_t ghosts = 0, recuts = 0, migrated = 0;
+    // Over the timed steps: bytes all ranks sent, rank 0's and the largest
+    // rank's seconds in collectives, collective calls per step (rank 0).
+    std::int64_t bytes = 0;
+    double commSecondsRank0 = 0.0, commSecondsMax = 0.0, callsPerStep = 0.0;
+    // Sampled after every timed call of steps: ghosts / owned over all ranks,
+    // and max/mean owned; means over the samples and the largest imbalance.
+    double ghostFraction = 0.0, imbalanceMean = 0.0, imbalanceMax = 0.0, imbalanceEnd = 0.0;
+};
+
+// The timing protocol on one rank of the domain decomposition: the bed
+// inserted on slabs cut at equal counts (the engine's load balance re-cuts them
+// at list builds when max/mean owned exceeds 1.10), the case's water shared
+// over the ranks, one untimed step, then `steps` steps timed by rank 0 in calls
+// of `sample` steps, each ended by a reduction (the time of the slowest rank).
+// The communicator's counters cover the timed calls only (the samples'
+// reductions between them are left out).  Collective.
+RankTiming timeOnRank(const dem::Communicator& comm, const dem::CaseSetup& setup,
+                      const std::vector<dem::InsertedParticle>& bed, const dem::SlabDecomposition& slabs, long steps,
+                      long sample) {
     const int material = setup.insertions.empty() ? 0 : setup.insertions.front().materialIndex;
+    std::unique_ptr<dem::Simulation> sim = dem::makeSimulation(setup);
+    auto exchange = std::make_shared<dem::GhostExchange>(comm, slabs);
+    sim->setDecomposition(exchange);
+    sim->insert(bed, material, dem::Vec3::Zero(), "bed");
+    if (setup.waterContent > 0.0) sim->setWaterContent(setup.waterContent);  // shared over the ranks
+    sim->step(1);
+    auto ownedEnergy = [&] { return comm.sum(sim->particles().kineticEnergy(sim->ownedCount())); };
+    const double e0 = ownedEnergy();
+    if (comm.rank() == 0) std::cout << "sample 0 - " << std::setprecision(8) << e0 << std::endl;
+    const long buildsBefore = sim->pairList().buildCount();
+    const std::size_t recutsBefore = exchange->recutCount(), migratedBefore = exchange->migratedCount();
+    comm.sum(0.0);  // start together
+    RankTiming t;
+    dem::CommunicationCounters timed;
+    double ghostFractionSum = 0.0, imbalanceSum = 0.0;
+    long samples = 0;
+    for (long done = 0; done < steps;) {
+        const long k = std::min(sample, steps - done);
+        const dem::CommunicationCounters before = comm.counters();
+        const auto t0 = Clock::now();
+        sim->step(k);
+        comm.sum(0.0);  // the slowest rank's time
+        t.seconds += secondsSince(t0);
+        const dem::CommunicationCounters after = comm.counters();
+        timed.seconds += after.seconds - before.seconds;
+        timed.exchangeCalls += after.exchangeCalls - before.exchangeCalls;
+        timed.reductionCalls += after.reductionCalls - before.reductionCalls;
+        timed.exchangeBytes += after.exchangeBytes - before.exchangeBytes;
+        timed.reductionBytes += after.reductionBytes - before.reductionBytes;
+        done += k;
+        const double e = ownedEnergy();
+        const double owned = static_cast<double>(sim->ownedCount());
+        const double ownedSum = comm.sum(owned);
+        const double ghostSum = comm.sum(static_cast<double>(sim->decomposition()->ghostCount()));
+        const double imbalance = ownedSum > 0.0 ? comm.max(owned) / (ownedSum / comm.size()) : 0.0;
+        ghostFractionSum += ownedSum > 0.0 ? ghostSum / ownedSum : 0.0;
+        imbalanceSum += imbalance;
+        t.imbalanceMax = std::max(t.imbalanceMax, imbalance);
+        t.imbalanceEnd = imbalance;
+        ++samples;
+        if (comm.rank() == 0) std::cout << "sample " << done << " - " << e << std::endl;
+    }
+    t.kineticEnergy = ownedEnergy();
+    t.ghosts = comm.sum(static_cast<std::int64_t>(sim->decomposition()->ghostCount()));
+    t.bytes = comm.sum(timed.bytesSent());
+    t.commSecondsRank0 = timed.seconds;
+    t.commSecondsMax = comm.max(timed.seconds);
+    t.callsPerStep = steps > 0 ? static_cast<double>(timed.calls()) / steps : 0.0;
+    t.builds = sim->pairList().buildCount() - buildsBefore;
+    t.recuts = static_cast<std::int64_t>(exchange->recutCount() - recutsBefore);
+    t.migrated = comm.sum(static_cast<std::int64_t>(exchange->migratedCount() - migratedBefore));
+    if (samples > 0) {
+        t.ghostFraction = ghostFractionSum / samples;
+        t.imbalanceMean = imbalanceSum / samples;
+    }
+    return t;
+}
+
+void printRankTiming(const RankTiming& t, int ranks, bool mpi, std::size_t n, long steps) {
+    const double particleSteps = static_cast<double>(n) * steps;
+    std::cout << std::setprecision(6) << "result threads " << ranks << "\n"
+              << "result ranks " << ranks << "\n"
+              << "result rank_kind " << (mpi ? "mpi" : "threads") << "\n"
+              << "result particles " << n << "\n"
+              << "result ghosts " << t.ghosts << "\n"
+              << "result steps " << steps << "\n"
+              << "result seconds " << t.seconds << "\n"
+              << "result particle_steps_per_s " << particleSteps / t.seconds << "\n"
+              << "result list_builds " << t.builds << "\n"
+              << "result kinetic_energy_end " << t.kineticEnergy << "\n"
+              << "result ghost_fraction " << t.ghostFraction << "\n"
+              << "result bytes_per_particle_step " << (particleSteps > 0 ? t.bytes / particleSteps : 0.0) << "\n"
+              << "result communication_seconds " << t.commSecondsRank0 << "\n"
+              << "result communication_seconds_max " << t.commSecondsMax << "\n"
+              << "result communication_share " << (t.seconds > 0 ? t.commSecondsRank0 / t.seconds : 0.0) << "\n"
+              << "result collectives_per_step " << t.callsPerStep << "\n"
+              << "result imbalance_mean " << t.imbalanceMean << "\n"
+              << "result imbalance_max " << t.imbalanceMax << "\n"
+              << "result imbalance_end " << t.imbalanceEnd << "\n"
+              << "result recuts " << t.recuts << "\n"
+              << "result migrated " << t.migrated << std::endl;
+}
+
+// timeSteps with -ranks R: the same protocol on R thread ranks of the domain
+// decomposition (timeOnRank).
+int timeStepsOnRanks(const Options& o, int ranks) {
+    const dem::CaseSetup setup = dem::readCaseSetup(o.get("case"));
     const long steps = o.wholeNumber("steps", 1000, 0);
     const long sample = std::max(1L, o.wholeNumber("sample", 100, 0));
     const std::vector<dem::InsertedParticle> bed = readBed(o.get("bed"));
     const dem::SlabDecomposition slabs = equalCountSlabs(bed, ranks);
-    const std::size_t n = bed.size();
-    double seconds = 0.0, kineticEnergy = 0.0;
-    long builds = 0;
-    std::int64_t ghosts = 0;
+    RankTiming timing;
     dem::Communicator::runThreadGroup(ranks, [&](const dem::Communicator& comm) {
-        std::unique_ptr<dem::Simulation> sim = dem::makeSimulation(setup);
-        sim->setDecomposition(std::make_shared<dem::GhostExchange>(comm, slabs));
-        sim->insert(bed, material, dem::Vec3::Zero(), "bed");
-        sim->step(1);
-        auto ownedEnergy = [&] { return comm.sum(sim->particles().kineticEnergy(sim->ownedCount())); };
-        const double e0 = ownedEnergy();
-        if (comm.rank() == 0) std::cout << "sample 0 - " << std::setprecision(8) << e0 << std::endl;
-        const long buildsBefore = sim->pairList().buildCount();
-        comm.sum(0.0);  // start together
-        const double elapsed = timedSteps(
-            *sim, steps, sample,
-            [&](long done) {
-                const double e = ownedEnergy();
-                if (comm.rank() == 0) std::cout << "sample " << done << " - " << e << std::endl;
-            },
-            [&] { comm.sum(0.0); });
-        const double energy = ownedEnergy();
-        const std::int64_t ghostSum = comm.sum(static_cast<std::int64_t>(sim->decomposition()->ghostCount()));
-        if (comm.rank() == 0) {
-            seconds = elapsed;
-            kineticEnergy = energy;
-            builds = sim->pairList().buildCount() - buildsBefore;
-            ghosts = ghostSum;
-        }
+        const RankTiming t = timeOnRank(comm, setup, bed, slabs, steps, sample);
+        if (comm.rank() == 0) timing = t;
     });
-    std::cout << std::setprecision(6) << "result threads " << ranks << "\n"
-              << "result ranks " << ranks << "\n"
-              << "result particles " << n << "\n"
-              << "result ghosts " << ghosts << "\n"
-              << "result steps " << steps << "\n"
-              << "result seconds " << seconds << "\n"
-              << "result particle_steps_per_s " << static_cast<double>(n) * steps / seconds << "\n"
-              << "result list_builds " << builds << "\n"
-              << "result kinetic_energy_end " << kineticEnergy << std::endl;
+    printRankTiming(timing, ranks, false, bed.size(), steps);
     return 0;
 }
 
-int timeSteps(const Options& o) {
+// timeSteps with -parallel: the same protocol on the ranks of an MPI launcher
+// (mpirun -np R demBench time ... -parallel), one rank per process; rank 0
+// prints.
+int timeStepsOnMpiRanks(const Options& o, const dem::Communicator& comm) {
+    const dem::CaseSetup setup = dem::readCaseSetup(o.get("case"));
+    const long steps = o.wholeNumber("steps", 1000, 0);
+    const long sample = std::max(1L, o.wholeNumber("sample", 100, 0));
+    const std::vector<dem::InsertedParticle> bed = readBed(o.get("bed"));
+    const dem::SlabDecomposition slabs = equalCountSlabs(bed, comm.size());
+    const RankTiming t = timeOnRank(comm, setup, bed, slabs, steps, sample);
+    if (comm.rank() == 0) printRankTiming(t, comm.size(), true, bed.size(), steps);
+    return 0;
+}
+
+int timeSteps(const Options& o, const dem::Communicator* mpi) {
+    if (mpi) {
+        if (o.has("ranks") || o.has("threads"))
+            throw dem::InputError("demBench time -parallel: one thread per MPI rank; give neither -ranks nor -threads");
+        return timeStepsOnMpiRanks(o, *mpi);
+    }
     if (o.has("ranks")) {
         const int ranks = static_cast<int>(o.wholeNumber("ranks", 1, 1));
         if (o.has("threads")) throw dem::InputError("demBench time: give -threads or -ranks, not both");
@@ -547,6 +650,7 @@ void usage(std::ostream& out) {
            "                       [-gravityFactor G] [-settleTime T] [-relaxTime T] [-speedTolerance V]\n"
            "                       [-quietSamples Q]\n"
            "       demBench time -case DIR -bed FILE -steps K [-threads N | -ranks R] [-sample S]\n"
+           "       mpirun -np R demBench time -case DIR -bed FILE -steps K [-sample S] -parallel\n"
            "       demBench copies -case DIR -bed FILE -steps K [-copies C]   (C independent 1-thread runs at once)\n"
            "Benchmark driver of bench/run; see docs/performance.md.\n";
 }
@@ -560,8 +664,13 @@ int main(int argc, char** argv) {
     }
     const std::string command = argv[1];
     Options o;
+    bool parallel = false;
     for (int i = 2; i < argc; ++i) {
         const std::string a = argv[i];
+        if (a == "-parallel") {
+            parallel = true;
+            continue;
+        }
         if (a.size() < 2 || a[0] != '-' || i + 1 >= argc) {
             std::cerr << "demBench: expected '-option value' pairs, got '" << a << "'\n";
             usage(std::cerr);
@@ -569,21 +678,51 @@ int main(int argc, char** argv) {
         }
         o.values[a.substr(1)] = argv[++i];
     }
+    if (parallel && command != "time") {
+        std::cerr << "demBench: -parallel is an option of 'time' only\n";
+        return 1;
+    }
+    // -parallel: MPI starts here, as in demRun; each rank one thread.
+    std::unique_ptr<dem::Communicator> mpi;
+    if (parallel) {
+#if DEMLIB_HAS_MPI
+        int provided = 0;
+        MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
+        mpi = std::make_unique<dem::Communicator>(dem::communicatorFromMpi(MPI_COMM_WORLD));
+#ifdef _OPENMP
+        omp_set_num_threads(1);
+#endif
+#else
+        std::cerr << "demBench: -parallel needs demLib built with MPI (this build has none)\n";
+        return 1;
+#endif
+    }
+    // Ends the run: MPI_Abort when a rank failed, since the others may wait
+    // for it in a collective.
+    auto leave = [&](int status) {
+#if DEMLIB_HAS_MPI
+        if (mpi) {
+            if (status == 0) MPI_Finalize();
+            else MPI_Abort(MPI_COMM_WORLD, status);
+        }
+#endif
+        return status;
+    };
     try {
 #ifdef _OPENMP
         if (o.has("threads")) omp_set_num_threads(static_cast<int>(std::max(1L, o.wholeNumber("threads", 1, 0))));
 #endif
         if (command == "settle") return settle(o);
-        if (command == "time") return timeSteps(o);
+        if (command == "time") return leave(timeSteps(o, mpi.get()));
         if (command == "copies") return independentCopies(o);
         std::cerr << "demBench: unknown command '" << command << "'; expected 'settle', 'time' or 'copies'\n";
         usage(std::cerr);
         return 1;
     } catch (const dem::InputError& e) {
         std::cerr << "demBench: input error: " << e.what() << std::endl;
-        return 1;
+        return leave(1);
     } catch (const std::exception& e) {
         std::cerr << "demBench: error: " << e.what() << std::endl;
-        return 2;
+        return leave(2);
     }
 }

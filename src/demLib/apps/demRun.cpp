@@ -2,12 +2,15 @@
 //   demRun [-case DIR] [-restart FILE|latest] [-threads N] [-parallel] [-help]
 // Reads DIR/constant/demProperties, writes DIR/<output>/ (particle fields as
 // HDF5 + XDMF for ParaView, summary.csv, restart files) and DIR/log.demRun.
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -218,9 +221,33 @@ int main(int argc, char** argv) {
             const bool mine = dem::stopSignalReceived() != 0;
             return comm.isSerial() ? mine : comm.anyTrue(mine);
         };
-        while (simulation.time() < end - 0.5 * dt && !stopping())
+        // -parallel: the communication of the run from here on (the
+        // communicator's counters; docs/performance.md, part (f)).
+        comm.resetCounters();
+        const auto runStart = std::chrono::steady_clock::now();
+        const long firstStep = simulation.stepCount();
+        double particleSteps = 0.0;
+        while (simulation.time() < end - 0.5 * dt && !stopping()) {
+            const long stepBefore = simulation.stepCount();
             runner.advanceTo(simulation.time() + 200.0 * dt);  // slices: same results as one call
+            if (parallel)
+                particleSteps += static_cast<double>(comm.sum(static_cast<std::int64_t>(simulation.ownedCount()))) *
+                                 static_cast<double>(simulation.stepCount() - stepBefore);
+        }
         runner.finish();
+        if (parallel) {
+            const dem::CommunicationCounters c = comm.counters();
+            const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - runStart).count();
+            const double bytes = static_cast<double>(comm.sum(c.bytesSent()));
+            const double slowest = comm.max(c.seconds);
+            const long steps = std::max(1L, simulation.stepCount() - firstStep);
+            log << "Communication over " << comm.size() << " ranks: " << std::setprecision(4)
+                << (particleSteps > 0.0 ? bytes / particleSteps : 0.0) << " bytes per particle-step, "
+                << c.seconds << " s in collectives on rank 0 (" << 100.0 * c.seconds / std::max(wall, 1e-9)
+                << " % of " << wall << " s), at most " << slowest << " s on a rank, "
+                << static_cast<double>(c.calls()) / static_cast<double>(steps) << " collectives per step"
+                << std::setprecision(6) << std::endl;
+        }
         int signal = dem::stopSignalReceived();
         if (!comm.isSerial()) signal = static_cast<int>(comm.max(static_cast<double>(signal)));
         if (signal != 0) {

@@ -1,5 +1,6 @@
 #include "demLib/communicator.hpp"
 
+#include <chrono>
 #include <exception>
 #include <limits>
 #include <mutex>
@@ -170,7 +171,14 @@ std::vector<std::vector<char>> processExchange(const Communicator&, const std::v
 
 template <class T>
 T Communicator::reduce(T value, ReduceOp op) const {
-    return threads_ ? threads_->reduce(rank_, value, op) : processReduce(*this, value, op);
+    if (size_ == 1) return threads_ ? threads_->reduce(rank_, value, op) : processReduce(*this, value, op);
+    const auto start = std::chrono::steady_clock::now();
+    const T result = threads_ ? threads_->reduce(rank_, value, op) : processReduce(*this, value, op);
+    CommunicationCounters& c = *counters_;
+    c.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    ++c.reductionCalls;
+    c.reductionBytes += static_cast<std::int64_t>(sizeof(T)) * (size_ - 1);
+    return result;
 }
 
 double Communicator::sum(double v) const { return reduce(v, ReduceOp::sum); }
@@ -183,7 +191,16 @@ std::vector<std::vector<char>> Communicator::exchange(const std::vector<std::vec
     if (static_cast<int>(sendTo.size()) != size_)
         throw RuntimeError("demLib communicator: exchange given " + std::to_string(sendTo.size()) +
                            " buffers; expected one per rank (" + std::to_string(size_) + ")");
-    return threads_ ? threads_->exchange(rank_, sendTo) : processExchange(*this, sendTo);
+    if (size_ == 1) return threads_ ? threads_->exchange(rank_, sendTo) : processExchange(*this, sendTo);
+    const auto start = std::chrono::steady_clock::now();
+    std::vector<std::vector<char>> received =
+        threads_ ? threads_->exchange(rank_, sendTo) : processExchange(*this, sendTo);
+    CommunicationCounters& c = *counters_;
+    c.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    ++c.exchangeCalls;
+    for (int r = 0; r < size_; ++r)
+        if (r != rank_) c.exchangeBytes += static_cast<std::int64_t>(sendTo[static_cast<std::size_t>(r)].size());
+    return received;
 }
 
 }  // namespace dem

@@ -20,6 +20,27 @@ namespace dem {
 class ThreadGroup;
 enum class ReduceOp;
 
+// What one rank's communicator has done since it was made or last reset
+// (Communicator::counters).  Only traffic between ranks counts: a group of one
+// rank counts nothing.
+struct CommunicationCounters {
+    std::int64_t exchangeCalls = 0;   // exchange() calls
+    std::int64_t reductionCalls = 0;  // sum, min, max, anyTrue calls
+    // Payload bytes this rank sent to other ranks: the exchange buffers
+    // addressed to other ranks, and one value (8 bytes) per other rank for each
+    // reduction.  The transport's own overhead (headers, the sizes an MPI
+    // exchange announces first, a reduction tree's relaying) is not counted.
+    std::int64_t exchangeBytes = 0;
+    std::int64_t reductionBytes = 0;
+    // Wall time spent inside the collectives (steady_clock around each call),
+    // waiting for the other ranks included: a rank that arrives first at a
+    // collective counts the time until the slowest arrives.
+    double seconds = 0.0;
+
+    std::int64_t calls() const { return exchangeCalls + reductionCalls; }
+    std::int64_t bytesSent() const { return exchangeBytes + reductionBytes; }
+};
+
 class Communicator {
 public:
     // The single-process group (rank 0 of 1).
@@ -55,6 +76,15 @@ public:
     // case), the result's element r is what rank r sent here.  Collective.
     std::vector<std::vector<char>> exchange(const std::vector<std::vector<char>>& sendTo) const;
 
+    // This rank's traffic and time in the collectives above.  A communicator
+    // and its copies share one set of counters (e.g. the copy a GhostExchange
+    // holds and the caller's); each rank of a group counts its own, and each
+    // communicatorFromMpi / serial() / runThreadGroup rank starts a new set at
+    // zero.  Counting costs two clock reads per collective and changes no
+    // result.  resetCounters() zeroes the shared set (local, not collective).
+    CommunicationCounters counters() const { return *counters_; }
+    void resetCounters() const { *counters_ = CommunicationCounters{}; }
+
     // Opaque MPI state, defined in communicator_mpi.hpp (MPI builds only).
     struct MpiHandle;
     explicit Communicator(std::shared_ptr<const MpiHandle> mpi, int rank, int size);
@@ -67,6 +97,7 @@ private:
     T reduce(T value, ReduceOp op) const;
     std::shared_ptr<const MpiHandle> mpi_;
     std::shared_ptr<ThreadGroup> threads_;
+    std::shared_ptr<CommunicationCounters> counters_ = std::make_shared<CommunicationCounters>();
     int rank_ = 0;
     int size_ = 1;
 };
