@@ -162,6 +162,22 @@ inline void ghostsGiveTheSerialContactForces(const dem::Communicator& comm) {
     if (comm.rank() == 0) std::printf("straddling contacts: %ld\n", static_cast<long>(straddling));
 }
 
+// Whether the ranks own, together, exactly the serial run's particles: the
+// count, the sum of the ids and the sum of their squares agree (a particle
+// owned twice or by none changes the count or, swapped for another, the sums).
+// Collective; the same answer on every rank.
+inline bool ownedOnceEach(const dem::Communicator& comm, const dem::Simulation& serial,
+                          const dem::Simulation& decomposed) {
+    std::int64_t count = 0, sum = 0, squares = 0;
+    for (std::size_t i = 0; i < decomposed.ownedCount(); ++i) {
+        const std::int64_t id = decomposed.particles().id[i];
+        ++count, sum += id, squares += id * id;
+    }
+    std::int64_t refCount = 0, refSum = 0, refSquares = 0;
+    for (std::int64_t id : serial.particles().id) ++refCount, refSum += id, refSquares += id * id;
+    return comm.sum(count) == refCount && comm.sum(sum) == refSum && comm.sum(squares) == refSquares;
+}
+
 // A granular gas in a box open at the top: particles cross the slab faces
 // (migration with their contact history), some leave the domain; positions
 // by id follow the serial run, and no particle is lost or doubled on the way.
@@ -174,8 +190,14 @@ inline void multiStepRunFollowsTheSerialRun(const dem::Communicator& comm) {
         firstOwner[runs->serial.particles().id[i]] =
             runs->exchange->slabs().ownerOf(runs->serial.particles().position[i], 0);
     const long steps = 600;
-    runs->serial.step(steps);
-    runs->decomposed.step(steps);
+    // Every step: each id the serial run holds is owned by exactly one rank.
+    std::int64_t badSteps = 0;
+    for (long s = 0; s < steps; ++s) {
+        runs->serial.step(1);
+        runs->decomposed.step(1);
+        if (!ownedOnceEach(comm, runs->serial, runs->decomposed)) ++badSteps;
+    }
+    EXPECT_EQ(badSteps, 0) << "steps after which some particle was owned by no rank or by two";
 
     const dem::ParticleStore& ref = runs->serial.particles();
     const dem::ParticleStore& mine = runs->decomposed.particles();
@@ -285,8 +307,16 @@ inline void wetRunSharesTheSerialLiquid(const dem::Communicator& comm) {
     expectLoadsMatch(comm, *runs, "wet, after 1 step");
 
     const long steps = 400;
-    runs->serial.step(steps);
-    runs->decomposed.step(steps);
+    std::int64_t badSteps = 0;
+    for (long s = 0; s < steps; ++s) {
+        runs->serial.step(1);
+        runs->decomposed.step(1);
+        if (!ownedOnceEach(comm, runs->serial, runs->decomposed)) ++badSteps;
+        // The water of the run, held by the bridges of all ranks and the pool
+        const double held = runs->decomposed.liquidInBridges();
+        if (!(std::abs(held + runs->decomposed.liquidOverRanks().poolVolume - total) <= 1e-12 * total)) ++badSteps;
+    }
+    EXPECT_EQ(badSteps, 0) << "steps after which a particle was owned twice or by none, or the liquid not conserved";
     const dem::ParticleStore& ref = runs->serial.particles();
     const dem::ParticleStore& p = runs->decomposed.particles();
     const std::vector<long> index = indexById(ref, static_cast<std::size_t>(runs->serial.nextId()));

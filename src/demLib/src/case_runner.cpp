@@ -743,7 +743,8 @@ void CaseRunner::logRecuts() {
     const GhostExchange::RebalanceReport& r = d->lastRecut();
     log_ << "DEM slabs re-cut at t = " << simulation_->time() << " s (" << d->recutCount() - recutsLogged_
          << " since the last line): owned particles max " << r.maxOwned << " / mean " << r.meanOwned
-         << " = " << r.imbalance << " before; cuts along " << "xyz"[d->slabs().axis()] << " now at";
+         << " = " << r.imbalance << " before, max/mean " << r.imbalanceAfter << " after; cuts along "
+         << "xyz"[d->slabs().axis()] << " now at";
     for (double c : r.cuts) log_ << " " << c;
     log_ << " m" << std::endl;
     recutsLogged_ = d->recutCount();

@@ -417,4 +417,11 @@ void GhostExchange::restoreHistory(const ParticleStore& p, ParticleParticleNeigh
     wallStash_.clear();
 }
 
+void GhostExchange::noteBalanceAfterMigration(const ParticleStore& particles) {
+    const double owned = static_cast<double>(ownedCount(particles));
+    const double largest = communicator_.max(owned);
+    const double mean = communicator_.sum(owned) / communicator_.size();
+    lastRecut_.imbalanceAfter = mean > 0.0 ? largest / mean : 1.0;
+}
+
 }  // namespace dem

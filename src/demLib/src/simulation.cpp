@@ -497,8 +497,9 @@ void Simulation::updatePairList() {
         // the owned counts drifted apart (the powder moved), particles to
         // their owners.
         decomposition_->dropGhosts(particles_, pairs_, wallContacts_);
-        decomposition_->rebalanceIfNeeded(particles_);
+        const bool recut = decomposition_->rebalanceIfNeeded(particles_).recut;
         decomposition_->migrate(particles_);
+        if (recut) decomposition_->noteBalanceAfterMigration(particles_);
     }
     double rMax = 0.0;
     for (double r : particles_.radius) rMax = std::max(rMax, r);

@@ -102,6 +102,9 @@ public:
         double meanOwned = 0.0;
         double imbalance = 0.0;
         std::vector<double> cuts;  // interior cuts after the call
+        // After a re-cut and the migration that follows it: max/mean owned
+        // (noteBalanceAfterMigration; 0 until then).
+        double imbalanceAfter = 0.0;
     };
     // A threshold t >= 1: re-cut when max/mean load > t.  0 or +infinity
     // disables balancing (rebalanceIfNeeded then does no collective; all ranks
@@ -124,6 +127,9 @@ public:
     const RebalanceReport& lastRebalance() const { return lastRebalance_; }
     // The report of the latest call that re-cut (front ends log it).
     const RebalanceReport& lastRecut() const { return lastRecut_; }
+    // After the migrate() that follows a re-cut: records max/mean owned in
+    // lastRecut().imbalanceAfter (two reductions).  Collective.
+    void noteBalanceAfterMigration(const ParticleStore& particles);
     // Particles this rank has sent to other ranks by migrate() so far.
     std::size_t migratedCount() const { return migrated_; }
 
