@@ -365,6 +365,35 @@ TEST(ThreadRanks, CollectivesGiveEveryRankTheSameResults) {
     EXPECT_THROW(dem::Communicator::runThreadGroup(0, [](const dem::Communicator&) {}), dem::InputError);
 }
 
+// The communication counters: the bytes sent to other ranks by exchange and
+// the reductions, the calls, shared by copies of a communicator, reset to zero;
+// a one-rank group counts nothing.
+TEST(ThreadRanks, CommunicationCountersCountWhatIsSent) {
+    for (int ranks : {2, 3}) {
+        dem::Communicator::runThreadGroup(ranks, [&](const dem::Communicator& c) {
+            c.resetCounters();
+            const dem::Communicator copy = c;
+            std::vector<std::vector<char>> send(ranks);
+            for (int to = 0; to < ranks; ++to) send[to].assign(to == c.rank() ? 5 : 10 * (c.rank() + 1), 'x');
+            c.exchange(send);
+            c.sum(1.0);
+            copy.max(2.0);
+            const dem::CommunicationCounters n = copy.counters();
+            EXPECT_EQ(n.exchangeCalls, 1);
+            EXPECT_EQ(n.reductionCalls, 2);
+            EXPECT_EQ(n.exchangeBytes, std::int64_t{10} * (c.rank() + 1) * (ranks - 1)) << "to itself not counted";
+            EXPECT_EQ(n.reductionBytes, std::int64_t{2} * 8 * (ranks - 1));
+            EXPECT_GE(n.seconds, 0.0);
+            c.sum(0.0);  // everyone has read before the reset
+            c.resetCounters();
+            EXPECT_EQ(copy.counters().calls(), 0);
+        });
+    }
+    const dem::Communicator one = dem::Communicator::serial();
+    one.sum(1.0);
+    EXPECT_EQ(one.counters().bytesSent(), 0);
+}
+
 // A rank that fails releases the others from their collective with an error,
 // and the first exception reaches the caller after all threads ended.
 TEST(ThreadRanks, AFailingRankStopsTheGroupWithItsError) {
