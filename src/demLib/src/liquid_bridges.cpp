@@ -7,32 +7,10 @@
 #endif
 
 #include "demLib/capillary_force.hpp"
+#include "demLib/compensated_sum.hpp"
 #include "demLib/error.hpp"
 
 namespace dem {
-
-namespace {
-
-// Neumaier's compensated sum: the liquid budget must close to ~1e-16, not to
-// N·1e-16, however many bonds there are.
-class CompensatedSum {
-public:
-    void add(double value) {
-        const double total = sum_ + value;
-        if (std::abs(sum_) >= std::abs(value))
-            compensation_ += (sum_ - total) + value;
-        else
-            compensation_ += (value - total) + sum_;
-        sum_ = total;
-    }
-    double value() const { return sum_ + compensation_; }
-
-private:
-    double sum_ = 0.0;
-    double compensation_ = 0.0;
-};
-
-}  // namespace
 
 void BridgeCandidates::clear() {
     radiusA.clear();

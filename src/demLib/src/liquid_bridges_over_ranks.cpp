@@ -10,33 +10,12 @@
 #endif
 
 #include "demLib/communicator.hpp"
+#include "demLib/compensated_sum.hpp"
 #include "demLib/error.hpp"
 
 namespace dem {
 
 namespace {
-
-// Neumaier's compensated sum (as in liquid_bridges.cpp): the budget closes to
-// ~1e-16 of the total however many bridges there are.  The running sum and
-// its compensation travel between ranks separately.
-class CompensatedSum {
-public:
-    void add(double value) {
-        const double total = sum_ + value;
-        if (std::abs(sum_) >= std::abs(value))
-            compensation_ += (sum_ - total) + value;
-        else
-            compensation_ += (value - total) + sum_;
-        sum_ = total;
-    }
-    double value() const { return sum_ + compensation_; }
-    double sum() const { return sum_; }
-    double compensation() const { return compensation_; }
-
-private:
-    double sum_ = 0.0;
-    double compensation_ = 0.0;
-};
 
 // Quantiles each rank proposes per round, and the most pivots tested at once.
 constexpr std::size_t proposalsPerRank = 8;
