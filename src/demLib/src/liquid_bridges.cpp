@@ -87,13 +87,33 @@ LiquidBridgeNetwork::LiquidBridgeNetwork(double totalLiquidVolume, const LiquidB
     distribution_.freeLiquid = totalLiquid_;  // nothing bonded before the first update
 }
 
-const BridgeDistribution& LiquidBridgeNetwork::update(const BridgeCandidates& candidates) {
+void requireConsistentCandidates(const BridgeCandidates& candidates, const LiquidBridgeSettings& settings) {
     const std::size_t pairCount = candidates.size();
     if (candidates.radiusA.size() != pairCount || candidates.radiusB.size() != pairCount)
         throw RuntimeError("liquid bridges: radius arrays and centre distances differ in length");
-    const bool persistent = settings_.formation == BridgeFormation::ContactThenPersist;
-    if (persistent && candidates.wasBonded.size() != pairCount)
+    if (settings.formation == BridgeFormation::ContactThenPersist && candidates.wasBonded.size() != pairCount)
         throw RuntimeError("liquid bridges: ContactThenPersist needs one wasBonded flag per candidate pair");
+}
+
+bool bridgeCandidateRank(const BridgeCandidates& candidates, std::size_t k, const LiquidBridgeSettings& settings,
+                         double& weight, double& threshold) {
+    const double ra = candidates.radiusA[k];
+    const double rb = candidates.radiusB[k];
+    const double distance = candidates.centreDistance[k];
+    if (!(ra > 0.0) || !(rb > 0.0) || !(distance > 0.0))
+        throw RuntimeError("liquid bridges: candidate pair " + std::to_string(k) +
+                           " has a non-positive radius or centre distance");
+    const double gap = distance - ra - rb;
+    if (settings.formation == BridgeFormation::ContactThenPersist && gap > 0.0 && !candidates.wasBonded[k])
+        return false;  // no contact, no bridge yet
+    weight = bridgeVolumeWeight(ra, rb, distance, settings.weight);
+    threshold = bridgeStabilityThreshold(gap, weight, settings.contactAngle);
+    return true;
+}
+
+const BridgeDistribution& LiquidBridgeNetwork::update(const BridgeCandidates& candidates) {
+    const std::size_t pairCount = candidates.size();
+    requireConsistentCandidates(candidates, settings_);
 
     distribution_.volume.assign(pairCount, 0.0);
     distribution_.bonded.assign(pairCount, 0);
@@ -106,16 +126,7 @@ const BridgeDistribution& LiquidBridgeNetwork::update(const BridgeCandidates& ca
     // λ*_k: the liquid per unit weight at which pair k's own bridge reaches its
     // debonding distance, gap_k = (1+θ/2)(λ w_k)^(1/3).  Overlapping pairs: 0.
     for (std::size_t k = 0; k < pairCount; ++k) {
-        const double ra = candidates.radiusA[k];
-        const double rb = candidates.radiusB[k];
-        const double distance = candidates.centreDistance[k];
-        if (!(ra > 0.0) || !(rb > 0.0) || !(distance > 0.0))
-            throw RuntimeError("liquid bridges: candidate pair " + std::to_string(k) +
-                               " has a non-positive radius or centre distance");
-        const double gap = distance - ra - rb;
-        if (persistent && gap > 0.0 && !candidates.wasBonded[k]) continue;  // no contact, no bridge yet
-        weight_[k] = bridgeVolumeWeight(ra, rb, distance, settings_.weight);
-        stabilityThreshold_[k] = bridgeStabilityThreshold(gap, weight_[k], settings_.contactAngle);
+        if (!bridgeCandidateRank(candidates, k, settings_, weight_[k], stabilityThreshold_[k])) continue;
         if (stabilityThreshold_[k] > 0.0)
             separatedPairs_.emplace_back(stabilityThreshold_[k], k);
         else

@@ -43,12 +43,9 @@ BridgeDistribution distributeLiquidOverRanks(const BridgeCandidates& candidates,
                                              const std::vector<std::uint8_t>& counted, double totalLiquid,
                                              const LiquidBridgeSettings& settings, const Communicator& communicator) {
     const std::size_t pairCount = candidates.size();
-    if (candidates.radiusA.size() != pairCount || candidates.radiusB.size() != pairCount ||
-        counted.size() != pairCount)
+    requireConsistentCandidates(candidates, settings);
+    if (counted.size() != pairCount)
         throw RuntimeError("liquid bridges over ranks: candidate arrays and counted flags differ in length");
-    const bool persistent = settings.formation == BridgeFormation::ContactThenPersist;
-    if (persistent && candidates.wasBonded.size() != pairCount)
-        throw RuntimeError("liquid bridges: ContactThenPersist needs one wasBonded flag per candidate pair");
 
     BridgeDistribution d;
     d.volume.assign(pairCount, 0.0);
@@ -58,17 +55,8 @@ BridgeDistribution distributeLiquidOverRanks(const BridgeCandidates& candidates,
     std::vector<std::pair<double, std::size_t>> ranked;  // (λ*, index) of the counted eligible pairs
     ranked.reserve(pairCount);
     for (std::size_t k = 0; k < pairCount; ++k) {
-        const double ra = candidates.radiusA[k], rb = candidates.radiusB[k];
-        const double distance = candidates.centreDistance[k];
-        if (!(ra > 0.0) || !(rb > 0.0) || !(distance > 0.0))
-            throw RuntimeError("liquid bridges: candidate pair " + std::to_string(k) +
-                               " has a non-positive radius or centre distance");
-        const double gap = distance - ra - rb;
-        if (persistent && gap > 0.0 && !candidates.wasBonded[k]) continue;  // no contact, no bridge yet
-        eligible[k] = 1;
-        weight[k] = bridgeVolumeWeight(ra, rb, distance, settings.weight);
-        threshold[k] = bridgeStabilityThreshold(gap, weight[k], settings.contactAngle);
-        if (counted[k]) ranked.emplace_back(threshold[k], k);
+        eligible[k] = bridgeCandidateRank(candidates, k, settings, weight[k], threshold[k]);
+        if (eligible[k] && counted[k]) ranked.emplace_back(threshold[k], k);
     }
 #ifdef _OPENMP
     __gnu_parallel::sort(ranked.begin(), ranked.end());

@@ -87,6 +87,17 @@ double bridgeStabilityThreshold(double radiusOfA, double radiusOfB, double dista
 // The same from the pair's gap and its weight w_k, when the caller has them.
 double bridgeStabilityThreshold(double gap, double weight, double contactAngle);
 
+// The rule every distribution applies to a candidate (LiquidBridgeNetwork::update
+// and distributeLiquidOverRanks): requireConsistentCandidates throws
+// RuntimeError for arrays of different lengths (and no wasBonded flags under
+// ContactThenPersist); bridgeCandidateRank throws RuntimeError for a
+// non-positive radius or centre distance and returns whether pair k may hold a
+// bridge (under ContactThenPersist: touching or bonded before), with its
+// weight w_k and stability threshold λ*_k when it may.
+void requireConsistentCandidates(const BridgeCandidates& candidates, const LiquidBridgeSettings& settings);
+bool bridgeCandidateRank(const BridgeCandidates& candidates, std::size_t k, const LiquidBridgeSettings& settings,
+                         double& weight, double& threshold);
+
 // Holds the total liquid of the sample and re-distributes it each time the
 // engine updates its contact list.  Scratch storage is kept between updates,
 // so a steady-state update does not allocate.
