@@ -15,6 +15,7 @@
 #include <sstream>
 #include <vector>
 
+#include "demLib/byte_buffer.hpp"
 #include "demLib/command_line.hpp"
 #include "demLib/error.hpp"
 #include "demLib/ghost_exchange.hpp"
@@ -756,56 +757,35 @@ std::size_t CaseRunner::particleCount() const {
     return comm.isSerial() ? owned : static_cast<std::size_t>(comm.sum(static_cast<std::int64_t>(owned)));
 }
 
-namespace {
-
-// Plain values between ranks of one executable.
-template <class T>
-void appendBytes(std::vector<char>& out, const T& value) {
-    const std::size_t at = out.size();
-    out.resize(at + sizeof(T));
-    std::memcpy(out.data() + at, &value, sizeof(T));
-}
-
-template <class T>
-T takeBytes(const std::vector<char>& in, std::size_t& at) {
-    if (at + sizeof(T) > in.size()) throw RuntimeError("demLib: truncated particle message between ranks");
-    T value;
-    std::memcpy(static_cast<void*>(&value), in.data() + at, sizeof(T));
-    at += sizeof(T);
-    return value;
-}
-
-}  // namespace
-
 ParticleStore CaseRunner::gatheredParticles() const {
     const Communicator& comm = options_.communicator;
     const ParticleStore& p = simulation_->particles();
     std::vector<std::vector<char>> send(comm.size());
-    std::vector<char>& out = send[0];
+    ByteWriter out{send[0]};
     for (std::size_t i = 0; i < simulation_->ownedCount(); ++i) {
-        appendBytes(out, p.id[i]);
-        appendBytes(out, p.position[i]);
-        appendBytes(out, p.velocity[i]);
-        appendBytes(out, p.omega[i]);
-        appendBytes(out, p.force[i]);
-        appendBytes(out, p.radius[i]);
-        appendBytes(out, p.mass[i]);
-        appendBytes(out, p.material[i]);
+        out.put(p.id[i]);
+        out.put(p.position[i]);
+        out.put(p.velocity[i]);
+        out.put(p.omega[i]);
+        out.put(p.force[i]);
+        out.put(p.radius[i]);
+        out.put(p.mass[i]);
+        out.put(p.material[i]);
     }
     const std::vector<std::vector<char>> received = comm.exchange(send);
     ParticleStore all;
     if (comm.rank() != 0) return all;
-    for (const std::vector<char>& in : received)
-        for (std::size_t at = 0; at < in.size();) {
-            all.id.push_back(takeBytes<std::int64_t>(in, at));
-            all.position.push_back(takeBytes<Vec3>(in, at));
-            all.velocity.push_back(takeBytes<Vec3>(in, at));
-            all.omega.push_back(takeBytes<Vec3>(in, at));
-            all.force.push_back(takeBytes<Vec3>(in, at));
+    for (const std::vector<char>& part : received)
+        for (ByteReader in{part}; !in.done();) {
+            all.id.push_back(in.get<std::int64_t>());
+            all.position.push_back(in.vec());
+            all.velocity.push_back(in.vec());
+            all.omega.push_back(in.vec());
+            all.force.push_back(in.vec());
             all.torque.push_back(Vec3::Zero());
-            all.radius.push_back(takeBytes<double>(in, at));
-            all.mass.push_back(takeBytes<double>(in, at));
-            all.material.push_back(takeBytes<int>(in, at));
+            all.radius.push_back(in.get<double>());
+            all.mass.push_back(in.get<double>());
+            all.material.push_back(in.get<int>());
             all.externalForce.push_back(Vec3::Zero());
         }
     return all;

@@ -5,46 +5,12 @@
 #include <limits>
 #include <string>
 
+#include "demLib/byte_buffer.hpp"
 #include "demLib/error.hpp"
 
 namespace dem {
 
 namespace {
-
-// Byte buffers of plain values (same executable on every rank: no byte-order
-// or layout conversion).
-struct ByteWriter {
-    std::vector<char>& out;
-    template <class T>
-    void put(const T& v) {
-        const std::size_t at = out.size();
-        out.resize(at + sizeof(T));
-        std::memcpy(out.data() + at, &v, sizeof(T));
-    }
-    void put(const Vec3& v) {
-        put(v.x());
-        put(v.y());
-        put(v.z());
-    }
-};
-
-struct ByteReader {
-    const std::vector<char>& in;
-    std::size_t at = 0;
-    template <class T>
-    T get() {
-        if (at + sizeof(T) > in.size()) throw RuntimeError("demLib ghost exchange: truncated message");
-        T v;
-        std::memcpy(&v, in.data() + at, sizeof(T));
-        at += sizeof(T);
-        return v;
-    }
-    Vec3 vec() {
-        const double x = get<double>(), y = get<double>(), z = get<double>();
-        return Vec3(x, y, z);
-    }
-    bool done() const { return at == in.size(); }
-};
 
 // Every ParticleStore field, in one place: a field added to the store must be
 // added here too, or migrating particles would lose it.

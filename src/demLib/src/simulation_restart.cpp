@@ -8,6 +8,7 @@
 #include <limits>
 #include <unordered_map>
 
+#include "demLib/byte_buffer.hpp"
 #include "demLib/error.hpp"
 #include "demLib/hdf5_file.hpp"
 #include "demLib/simulation.hpp"
@@ -56,29 +57,6 @@ struct RestartData {
     std::vector<Vec3> wallShear, wallRolling, wallForce;
     std::vector<double> wallBridge;
 };
-
-// Plain bytes between ranks of one executable (no conversion needed).
-template <class T>
-void putVector(std::vector<char>& out, const std::vector<T>& v) {
-    const std::uint64_t n = v.size();
-    const std::size_t at = out.size();
-    out.resize(at + sizeof n + n * sizeof(T));
-    std::memcpy(out.data() + at, &n, sizeof n);
-    if (n) std::memcpy(out.data() + at + sizeof n, v.data(), n * sizeof(T));
-}
-
-template <class T>
-void appendVector(const std::vector<char>& in, std::size_t& at, std::vector<T>& v) {
-    std::uint64_t n = 0;
-    if (at + sizeof n > in.size()) throw RuntimeError("restart gather: truncated message");
-    std::memcpy(&n, in.data() + at, sizeof n);
-    at += sizeof n;
-    if (at + n * sizeof(T) > in.size()) throw RuntimeError("restart gather: truncated message");
-    const std::size_t old = v.size();
-    v.resize(old + n);
-    if (n) std::memcpy(static_cast<void*>(v.data() + old), in.data() + at, n * sizeof(T));
-    at += n * sizeof(T);
-}
 
 // Every field, in one order for packing and unpacking.
 template <class F>
@@ -188,15 +166,16 @@ void Simulation::writeRestart(const std::string& path) const {
         lost = comm.sum(lost);
         lostMass = comm.sum(lostMass);
         std::vector<std::vector<char>> send(comm.size());
-        forEachField(d, [&](const auto& v) { putVector(send[0], v); });
+        ByteWriter w{send[0]};
+        forEachField(d, [&](const auto& v) { w.putVector(v); });
         const std::vector<std::vector<char>> received = comm.exchange(send);
         writer = comm.rank() == 0;
         if (writer) {
             RestartData all;
             for (const std::vector<char>& part : received) {
-                std::size_t at = 0;
-                forEachField(all, [&](auto& v) { appendVector(part, at, v); });
-                if (at != part.size()) throw RuntimeError("restart gather: malformed message");
+                ByteReader in{part};
+                forEachField(all, [&](auto& v) { in.appendVector(v); });
+                if (!in.done()) throw RuntimeError("restart gather: malformed message");
             }
             d = std::move(all);
         }
@@ -582,8 +561,9 @@ bool Simulation::readRestartDecomposed(const std::string& path) {
             }
             const std::vector<double> header = loaded.header();
             for (int r = 0; r < ranks; ++r) {
-                putVector(send[r], header);
-                forEachField(part[r], [&](const auto& v) { putVector(send[r], v); });
+                ByteWriter w{send[r]};
+                w.putVector(header);
+                forEachField(part[r], [&](const auto& v) { w.putVector(v); });
             }
         } catch (const InputError& e) {
             failure = e.what();
@@ -601,11 +581,10 @@ bool Simulation::readRestartDecomposed(const std::string& path) {
     std::vector<double> header;
     RestartData d;
     {
-        const std::vector<char>& in = received[0];
-        std::size_t at = 0;
-        appendVector(in, at, header);
-        forEachField(d, [&](auto& v) { appendVector(in, at, v); });
-        if (at != in.size()) throw RuntimeError("restart: malformed message from rank 0");
+        ByteReader in{received[0]};
+        in.appendVector(header);
+        forEachField(d, [&](auto& v) { in.appendVector(v); });
+        if (!in.done()) throw RuntimeError("restart: malformed message from rank 0");
     }
     LoadedRestart scalars;
     scalars.setHeader(header);
