@@ -317,16 +317,7 @@ struct CompensatedSum {
 
 double Simulation::liquidInBridges() const {
     CompensatedSum total;
-    if (decomposition_) {
-        const std::vector<std::uint8_t> counted = countedPairs();
-        const std::vector<double>& bridge = pairs_.bridgeVolume();
-        for (std::size_t k = 0; k < bridge.size(); ++k)
-            if (counted[k]) total.add(bridge[k]);
-        const std::size_t owned = ownedCount();
-        for (const WallContactRecord& r : wallContacts_.records())
-            if (static_cast<std::size_t>(r.particle) < owned) total.add(r.bridgeVolume);
-        return decomposition_->communicator().sum(total.sum);
-    }
+    if (decomposition_) return decomposition_->communicator().sum(heldLiquidHere(true, true).volume);
     for (double v : pairs_.bridgeVolume()) total.add(v);
     for (const WallContactRecord& r : wallContacts_.records()) total.add(r.bridgeVolume);
     return total.sum;
@@ -334,13 +325,7 @@ double Simulation::liquidInBridges() const {
 
 double Simulation::liquidInWallBridges() const {
     CompensatedSum total;
-    if (decomposition_) {
-        // A ghost's wall records are its owner's business.
-        const std::size_t owned = ownedCount();
-        for (const WallContactRecord& r : wallContacts_.records())
-            if (static_cast<std::size_t>(r.particle) < owned) total.add(r.bridgeVolume);
-        return decomposition_->communicator().sum(total.sum);
-    }
+    if (decomposition_) return decomposition_->communicator().sum(heldLiquidHere(false, true).volume);
     for (const WallContactRecord& r : wallContacts_.records()) total.add(r.bridgeVolume);
     return total.sum;
 }
@@ -358,26 +343,36 @@ double Simulation::liquidCoordinationNumber() const {
 LiquidState Simulation::liquidOverRanks() const {
     if (!decomposition_) return liquid_;
     const Communicator& comm = decomposition_->communicator();
-    const std::vector<std::uint8_t> counted = countedPairs();
-    const std::vector<double>& bridge = pairs_.bridgeVolume();
-    std::int64_t bridges = 0, wallBridges = 0;
-    CompensatedSum held;
-    for (std::size_t k = 0; k < bridge.size(); ++k)
-        if (counted[k] && bridge[k] > 0.0) {
-            ++bridges;
-            held.add(bridge[k]);
-        }
-    const std::size_t owned = ownedCount();
-    for (const WallContactRecord& r : wallContacts_.records())
-        if (static_cast<std::size_t>(r.particle) < owned && r.bridgeVolume > 0.0) {
-            ++wallBridges;
-            held.add(r.bridgeVolume);
-        }
+    const HeldLiquid held = heldLiquidHere(true, true);
     LiquidState now = liquid_;
-    now.bridgeCount = static_cast<std::size_t>(comm.sum(bridges));
-    now.wallBridgeCount = static_cast<std::size_t>(comm.sum(wallBridges));
-    now.poolVolume = now.totalVolume - comm.sum(held.sum);
+    now.bridgeCount = static_cast<std::size_t>(comm.sum(held.pairBridges));
+    now.wallBridgeCount = static_cast<std::size_t>(comm.sum(held.wallBridges));
+    now.poolVolume = now.totalVolume - comm.sum(held.volume);
     return now;
+}
+
+Simulation::HeldLiquid Simulation::heldLiquidHere(bool pairs, bool walls) const {
+    HeldLiquid held;
+    CompensatedSum volume;
+    if (pairs) {
+        const std::vector<std::uint8_t> counted = countedPairs();
+        const std::vector<double>& bridge = pairs_.bridgeVolume();
+        for (std::size_t k = 0; k < bridge.size(); ++k)
+            if (counted[k] && bridge[k] > 0.0) {
+                ++held.pairBridges;
+                volume.add(bridge[k]);
+            }
+    }
+    if (walls) {
+        const std::size_t owned = ownedCount();  // a ghost's wall records are its owner's
+        for (const WallContactRecord& r : wallContacts_.records())
+            if (static_cast<std::size_t>(r.particle) < owned && r.bridgeVolume > 0.0) {
+                ++held.wallBridges;
+                volume.add(r.bridgeVolume);
+            }
+    }
+    held.volume = volume.sum;
+    return held;
 }
 
 double Simulation::coordinationNumber() const {

@@ -217,6 +217,13 @@ private:
     // two owned particles; a pair with a ghost on the rank owning the smaller
     // id), so that sums over ranks count each pair once.
     std::vector<std::uint8_t> countedPairs() const;
+    // This rank's share of the liquid held by particle (`pairs`) and wall
+    // (`walls`) bridges, each bridge on one rank only, and their counts.
+    struct HeldLiquid {
+        double volume = 0.0;
+        std::int64_t pairBridges = 0, wallBridges = 0;
+    };
+    HeldLiquid heldLiquidHere(bool pairs, bool walls) const;
     // Runs `check`; with a decomposition a failure on any rank is a failure
     // on all (with the failing rank's message where it is known), so that no
     // rank goes on to a collective the others never reach.
