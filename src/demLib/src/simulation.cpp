@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "demLib/cell_bins.hpp"
+#include "demLib/compensated_sum.hpp"
 #include "demLib/constants.hpp"
 #include "demLib/contact_stability.hpp"
 #include "demLib/error.hpp"
@@ -299,35 +300,19 @@ void Simulation::setWaterContent(double w) {
     forcesValid_ = false;
 }
 
-namespace {
-
-// Kahan-compensated running sum: the conservation check is to 1e-12 of the total.
-struct CompensatedSum {
-    double sum = 0.0;
-    double carry = 0.0;
-    void add(double value) {
-        const double y = value - carry;
-        const double t = sum + y;
-        carry = (t - sum) - y;
-        sum = t;
-    }
-};
-
-}  // namespace
-
 double Simulation::liquidInBridges() const {
     CompensatedSum total;
     if (decomposition_) return decomposition_->communicator().sum(heldLiquidHere(true, true).volume);
     for (double v : pairs_.bridgeVolume()) total.add(v);
     for (const WallContactRecord& r : wallContacts_.records()) total.add(r.bridgeVolume);
-    return total.sum;
+    return total.value();
 }
 
 double Simulation::liquidInWallBridges() const {
     CompensatedSum total;
     if (decomposition_) return decomposition_->communicator().sum(heldLiquidHere(false, true).volume);
     for (const WallContactRecord& r : wallContacts_.records()) total.add(r.bridgeVolume);
-    return total.sum;
+    return total.value();
 }
 
 double Simulation::liquidCoordinationNumber() const {
@@ -371,7 +356,7 @@ Simulation::HeldLiquid Simulation::heldLiquidHere(bool pairs, bool walls) const 
                 volume.add(r.bridgeVolume);
             }
     }
-    held.volume = volume.sum;
+    held.volume = volume.value();
     return held;
 }
 
