@@ -31,7 +31,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _common import argument_parser, positive, run_main  # noqa: E402
-from diefillpost import foamdict  # noqa: E402
+from diefillpost import foamdict, shoemotion  # noqa: E402
 from diefillpost.cavity import UNITS, Cavity, CavityError, table_triangles, write_stl  # noqa: E402
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -156,50 +156,23 @@ def shoe_path(motion, start_xy, scale, path):
             points += [(t0, points[-1][1], start_xy[1]), (t1, x, start_xy[1])]
         return segments, points
     motion.check_keys(["type", "file", "points"])
-    if motion.has("file"):
-        name = motion.d["file"]
-        full = os.path.join(os.path.dirname(os.path.dirname(path)), name)
-        try:
-            rows = []
-            with open(full) as f:
-                for line in f:
-                    s = line.split("#")[0].replace(",", " ").split()
-                    if not s:
-                        continue
-                    try:
-                        rows.append([float(x) for x in s])
-                    except ValueError:
-                        if rows:
-                            raise
-        except OSError as e:
-            motion.fail("file", "a readable table of time [s], x, y", f"{name} ({e.strerror})")
-        except ValueError:
-            motion.fail("file", "rows of numbers: time [s], x, y (a header line first is allowed)", name)
-    else:
-        rows = motion.d.get("points")
-        if not isinstance(rows, list):
-            motion.fail("points", "a list ((t x y) ...) or a file")
-    rows = [list(r) for r in rows]
-    if len(rows) < 2 or any(len(r) not in (2, 3) or not all(isinstance(v, float) and math.isfinite(v) for v in r)
-                            for r in rows):
-        motion.fail("file" if motion.has("file") else "points",
-                    "at least two rows of (time x) or (time x y), numbers", rows[:3])
-    t = [r[0] for r in rows]
-    if any(b <= a for a, b in zip(t, t[1:])) or t[0] < 0:
-        motion.fail("file" if motion.has("file") else "points", "times >= 0 that increase from row to row", t[:6])
-    xy = np.array([[r[1], r[2] if len(r) == 3 else 0.0] for r in rows]) * scale
-    # The table's positions are the shoe centre's, in the die's unit, relative to its start
-    offset = np.array(start_xy) - xy[0]
-    xy += offset
-    segments = []
-    for k in range(len(rows) - 1):
-        dt = t[k + 1] - t[k]
-        v = (xy[k + 1] - xy[k]) / dt
-        if np.any(v != 0):
-            segments.append((t[k], t[k + 1], (float(v[0]), float(v[1]))))
-    if not segments:
-        motion.fail("file" if motion.has("file") else "points", "a table in which the shoe moves", rows[:3])
-    points = [(t[k], float(xy[k, 0]), float(xy[k, 1])) for k in range(len(rows))]
+    key = "file" if motion.has("file") else "points"
+    try:
+        if motion.has("file"):
+            name = motion.d["file"]
+            rows = shoemotion.read_table(os.path.join(os.path.dirname(os.path.dirname(path)), name))
+        else:
+            rows = motion.d.get("points")
+            if not (isinstance(rows, list) and all(isinstance(r, list) and len(r) in (2, 3)
+                                                   and all(isinstance(v, float) for v in r) for r in rows)):
+                motion.fail("points", "a list ((t x y) ...) of numbers, or a file", rows)
+        segments, points = shoemotion.segments(rows, start_xy, scale, "the table")
+    except DictError:
+        raise
+    except OSError as e:
+        motion.fail(key, "a readable table of time [s], x, y", f"{motion.d.get('file')} ({e.strerror})")
+    except ValueError as e:
+        motion.fail(key, str(e))
     return segments, points
 
 
@@ -384,9 +357,7 @@ def write_case(case, path, rel, a):
                    for t in box_shoe_triangles(2 * half[0], 2 * half[1], height)])
 
     # ---- constant/demProperties ----
-    motion_lines = "\n".join(
-        f"            move{k} {{ type translate; start {t0:.9g}; end {t1:.9g}; velocity ({v[0]:.9g} {v[1]:.9g} 0); }}"
-        for k, (t0, t1, v) in enumerate(segments))
+    motion_lines = shoemotion.motion_block(segments)
     opening = (f"motion {{ open {{ type translate; start {open_start:.9g}; end {open_end:.9g}; "
                f"velocity (0 0 {-OPENING_SPEED:g}); }} }}" if lower else "")
     if shoe_type == "box":
