@@ -8,7 +8,9 @@ Modules (one concept each):
     profile    bed surface profiles and fitted slope angles
     plate      mass on a tilting plate, slid fraction vs plate angle
     plots      PNG pictures (matplotlib, Agg)
-    results    results.json + results.csv
+    results    results.json + results.csv (write, or update: merged with what is there)
+    closedmesh a closed STL surface (a die cavity): points inside, depth, volume per cell
     output     output files that replace the old ones only once complete
 """
-__all__ = ["foamdict", "series", "summary", "geometry", "profile", "plate", "plots", "results", "output"]
+__all__ = ["foamdict", "series", "summary", "geometry", "profile", "plate", "plots", "results", "output",
+           "closedmesh"]

@@ -30,3 +30,28 @@ def write(case_dir, results, name="results"):
 def read(case_dir, name="results"):
     with open(os.path.join(case_dir, "postProcessing", name + ".json")) as f:
         return json.load(f)
+
+
+def existing(case_dir, name="results"):
+    """The results in <case>/postProcessing/<name>.json ({} when there is none); a file that
+    is not a JSON object is a ValueError naming it."""
+    path = os.path.join(case_dir, "postProcessing", name + ".json")
+    if not os.path.exists(path):
+        return {}
+    try:
+        with open(path) as f:
+            old = json.load(f)
+    except ValueError as e:
+        raise ValueError(f"'{path}' is not valid JSON ({e}); move it aside to write new results") from None
+    if not isinstance(old, dict):
+        raise ValueError(f"'{path}' is not a JSON object of results; move it aside to write new results")
+    return old
+
+
+def update(case_dir, results, name="results"):
+    """Adds `results` to <case>/postProcessing/<name>.json and .csv (as write()), keeping
+    the keys that are there already (other tools' results); a key given again is replaced.
+    A <name>.json that is not a JSON object is a ValueError naming it (it is left as it is)."""
+    merged = existing(case_dir, name)
+    merged.update(results)
+    return write(case_dir, merged, name)
