@@ -1,0 +1,83 @@
+"""Physical checks of an own-die example run (tests/ownDie/run): the masses in the cavity and
+its regions from dem/summary.csv, the figures of postProcessing/results.json, the derived
+figures of constant/dieCase.json.  Usage: check_example.py ring|twoLevel CASE.
+One line per check, 'PASS: ...' or 'FAIL: ...'."""
+import csv
+import json
+import os
+import sys
+
+SAND = 2650.0
+
+
+def main(name, case):
+    ok = []
+
+    def check(what, cond, detail=""):
+        ok.append(bool(cond))
+        print(("PASS: " if cond else "FAIL: ") + f"{name}: {what}" + (f" ({detail})" if detail else ""), flush=True)
+
+    try:
+        info = json.load(open(os.path.join(case, "constant", "dieCase.json")))
+        rows = list(csv.DictReader(open(os.path.join(case, "dem", "summary.csv"))))
+    except OSError as e:
+        check("the run's dieCase.json and dem/summary.csv exist", False, str(e))
+        return 1
+    t = [float(r["time"]) for r in rows]
+    filled_time = info["timeline_s"]["filled"]
+    k_filled = max(i for i, x in enumerate(t) if x <= filled_time + 1e-9)
+    at = rows[k_filled]
+    volume = info["cavityVolume_m3"]
+    cavity = float(at["mass_cavity"])
+    fraction = cavity / (volume * SAND)
+    check(f"filled at t = {filled_time:.3g} s: solid fraction in the cavity {fraction:.3f} within 0.40-0.66 "
+          f"(a poured packing of F32 parcels; {cavity * 1e3:.2f} g in {volume * 1e6:.2f} cm3)", 0.40 <= fraction <= 0.66)
+    grid = sum(float(v) for k, v in at.items() if k.startswith("mass_grid_"))
+    check("the region grid's masses add up to the cavity's (every parcel in one region)",
+          abs(grid - cavity) <= 0.01 * cavity, f"{grid * 1e3:.3f} g vs {cavity * 1e3:.3f} g")
+    results_path = os.path.join(case, "postProcessing", "results.json")
+    try:
+        results = json.load(open(results_path))
+    except (OSError, ValueError) as e:
+        results = {}
+        check("postProcessing/results.json written", False, str(e))
+    fd = results.get("fillDensity", results)
+
+    def number(key):
+        v = fd.get(key) if isinstance(fd, dict) else None
+        if v is None:
+            v = results.get("fillDensity." + key)
+        return v
+
+    mean = number("mean")
+    check("results.json holds the fill density's mean, max - min and coefficient of variation",
+          all(number(k) is not None for k in ("mean", "maxMinusMin", "coefficientOfVariation")), str(list(fd)[:12]))
+    if mean is not None:
+        check(f"the mean column bulk density {mean:.0f} kg/m3 is the cavity's mass / volume "
+              f"{cavity / volume:.0f} kg/m3 within 5 %", abs(mean - cavity / volume) <= 0.05 * cavity / volume)
+
+    if name == "ring":
+        # The shoe comes from -x: the half of the ring it reaches first holds more when half the
+        # final mass is in (the powder falls in from the shoe's front as it passes).
+        half = 0.5 * cavity
+        k50 = next(i for i, r in enumerate(rows) if float(r["mass_cavity"]) >= half)
+        near, far = float(rows[k50]["mass_nearHalf"]), float(rows[k50]["mass_farHalf"])
+        check(f"at half fill (t = {t[k50]:.3f} s) the near half holds more than the far half "
+              f"({near * 1e3:.2f} g vs {far * 1e3:.2f} g)", near > far)
+        check("near + far halves = the cavity (regions from the dieDict)",
+              abs(float(at["mass_nearHalf"]) + float(at["mass_farHalf"]) - cavity) <= 0.01 * cavity)
+    else:
+        v_shallow, v_deep = 24e-3 * 24e-3 * 10e-3, 8e-3 * 24e-3 * 20e-3
+        shallow = float(at["mass_shallow"]) / v_shallow
+        deep = float(at["mass_deepStrip"]) / v_deep
+        check(f"the narrow deep strip fills less densely than the wide level ({deep:.0f} vs {shallow:.0f} kg/m3: "
+              f"the walls of an 8 mm strip hold parcels of up to 5 mm apart)", deep < shallow)
+        check("both levels hold powder (the strip fills through the level above)", deep > 0.3 * SAND and shallow > 0.3 * SAND)
+    lost = float(rows[-1]["lostMass"])
+    check(f"after the die wall is lowered the bed stands on the floors: {lost * 1e3:.2f} g lost of "
+          f"{cavity * 1e3:.2f} g", lost <= 0.5 * cavity)
+    return 0 if all(ok) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1], sys.argv[2]))
