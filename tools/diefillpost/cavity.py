@@ -17,7 +17,7 @@ import os
 
 import numpy as np
 
-from .closedmesh import read_stl as _read_stl
+from .closedmesh import ClosedMesh, read_stl as _read_stl
 
 UNITS = {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6, "inch": 0.0254}
 SMALLEST_DIE = 1e-3   # m: a cavity smaller than this, or larger than LARGEST_DIE, is a unit mistake
@@ -56,36 +56,6 @@ def write_stl(path, name, triangles):
     os.replace(tmp, path)
 
 
-def weld(triangles, tolerance):
-    """Shared vertices: (vertices (V, 3), faces (F, 3)); corners closer than `tolerance` merge."""
-    corners = triangles.reshape(-1, 3)
-    keys = np.round(corners / tolerance).astype(np.int64)
-    _, first, index = np.unique(keys, axis=0, return_index=True, return_inverse=True)
-    return corners[first], index.reshape(-1, 3)
-
-
-def open_edges(faces):
-    """Edges (a, b) used by one face only, or by two faces in the same direction
-    (inconsistent orientation), as an (E, 2) array; empty for a closed, oriented surface."""
-    directed = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
-    undirected = np.sort(directed, axis=1)
-    _, inverse, counts = np.unique(undirected, axis=0, return_inverse=True, return_counts=True)
-    bad = counts[inverse.ravel()] != 2
-    # Two uses of one edge must run in opposite directions.
-    order = np.lexsort((directed[:, 1], directed[:, 0]))
-    d = directed[order]
-    same = np.all(d[1:] == d[:-1], axis=1)
-    dup = np.zeros(len(directed), bool)
-    dup[order[1:][same]] = True
-    dup[order[:-1][same]] = True
-    return directed[bad | dup]
-
-
-def signed_volume(vertices, faces):
-    a, b, c = vertices[faces[:, 0]], vertices[faces[:, 1]], vertices[faces[:, 2]]
-    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
-
-
 class Cavity:
     """A closed cavity surface in metres, its opening at z = 0.
 
@@ -110,23 +80,12 @@ class Cavity:
                 f"{names}: with unit '{unit}' the cavity is {width:.6g} m across; expected {SMALLEST_DIE * 1e3:g} mm "
                 f"to {LARGEST_DIE:g} m: check the unit (the STL's numbers are {width / UNITS[unit]:.6g} across)")
         self.tolerance = 1e-6 * width
-        self.vertices, self.faces = weld(tris, self.tolerance)
-        v = self.vertices
-        area = np.linalg.norm(np.cross(v[self.faces[:, 1]] - v[self.faces[:, 0]],
-                                       v[self.faces[:, 2]] - v[self.faces[:, 0]]), axis=1)
-        self.faces = self.faces[area > (self.tolerance ** 2)]   # degenerate slivers carry no surface
-        bad = open_edges(self.faces)
-        if len(bad):
-            p = self.vertices[bad[0, 0]] / UNITS[unit]
-            raise CavityError(
-                f"{names}: the surface is not closed: {len(bad)} edge(s) bound one triangle or two triangles facing "
-                f"the same way (e.g. at ({p[0]:.6g} {p[1]:.6g} {p[2]:.6g}) in the file's units); expected a "
-                f"closed, consistently oriented surface (a watertight solid of the cavity)")
-        volume = signed_volume(self.vertices, self.faces)
-        if volume < 0:
-            self.faces = self.faces[:, ::-1].copy()   # outward normals
-            volume = -volume
-        self.volume = volume
+        try:
+            # welded, checked closed, turned outward (closedmesh.py)
+            mesh = ClosedMesh(tris, names)
+        except ValueError as e:
+            raise CavityError(str(e) + ("" if unit == "m" else f" (coordinates in m; the file's are in {unit})"))
+        self.vertices, self.faces, self.volume = mesh.vertices.copy(), mesh.faces, mesh.volume
         top = self.vertices[:, 2].max()
         if place:
             self.vertices = self.vertices - np.array([0.0, 0.0, top])
