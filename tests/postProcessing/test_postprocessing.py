@@ -741,6 +741,29 @@ def ladder_report_statistics():
           r.stderr[-300:])
 
 
+@test
+def ladder_wall_time():
+    """validation/ladder's wall time of a run: the solver's segments (a start and a continuation,
+    the first stopped by the machine before its last line) summed from their progress lines, less
+    the paused time logged by fullRun; a wrong reading (only the last segment, or the pause kept)
+    differs by 1 h or more."""
+    from importlib.machinery import SourceFileLoader
+    ladder = SourceFileLoader("ladder_module", LADDER).load_module()
+    run = os.path.join(TMP, "ladder", "walltime")
+    os.makedirs(os.path.join(run, "case"))
+    with open(os.path.join(run, "case", "log.diefillFoam"), "w") as f:
+        f.write("Exec   : diefillFoam\nProgress: t = 1 s of 13 s (7.7 %), elapsed 30 s, ETA 6 min\n"
+                "Progress: t = 9.8 s of 13 s (75.6 %), elapsed 2 h 46 min, ETA 43 min 21 s\n"
+                "Exec   : diefillFoam\nProgress: t = 10 s of 13 s (77 %), elapsed 2 min 3 s, ETA 40 min\n"
+                "t = 13.0000 s (100.0 %)  step 2080000  particles 19066  elapsed 1h1m53s  ETA 0s\r\n")
+    with open(os.path.join(run, "run.log"), "w") as f:
+        f.write("==== 2026-12-03 16:00:00 UTC: fullRun pause\n==== 2026-12-03 16:30:00 UTC: fullRun resume\n")
+    got = ladder.wall_seconds(run)
+    want = 2 * 3600 + 46 * 60 + 3600 + 60 + 53 - 1800
+    check("ladder wall time: segments summed from their progress lines, the logged pause left out",
+          abs(got - want) < 1e-9, f"(got {got} s, want {want} s)")
+
+
 import shutil  # noqa: E402
 
 shutil.rmtree(TMP, ignore_errors=True)
