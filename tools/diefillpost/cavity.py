@@ -268,15 +268,52 @@ def polygon_with_holes(outer, holes):
     return np.array([[poly[i] for i in t] for t in _ear_clip(poly)])
 
 
-def table_triangles(loops, lower, upper, z=0.0):
+def _outline(lo, hi, nx, ny):
+    """The box [lo, hi]'s outline, counter-clockwise, through the nodes of an nx x ny grid."""
+    xs, ys = np.linspace(lo[0], hi[0], nx + 1), np.linspace(lo[1], hi[1], ny + 1)
+    return np.array([[x, ys[0]] for x in xs[:-1]] + [[xs[-1], y] for y in ys[:-1]]
+                    + [[x, ys[-1]] for x in xs[:0:-1]] + [[xs[0], y] for y in ys[:0:-1]])
+
+
+def table_triangles(loops, lower, upper, z=0.0, spacing=None):
     """The table (T, 3, 3): the rectangle [lower, upper] in x, y minus the opening, whose
-    outline is `loops`; islands of the table inside the opening (the top of a core) included."""
-    rect = np.array([[lower[0], lower[1]], [upper[0], lower[1]], [upper[0], upper[1]], [lower[0], upper[1]]], float)
+    outline is `loops`; islands of the table inside the opening (the top of a core) included.
+
+    Triangles of bounded size: a wall's triangles are found by their bounding boxes, and a
+    triangle as large as the table is a candidate for every particle on it (the ring example
+    spent 80 % of its DEM time in that search with a plain ear clipping of the rectangle).
+    So the rectangle is a grid of squares about `spacing` wide (default: a quarter of the
+    opening's smaller width), two triangles each, except a frame of grid cells around the
+    opening, which is ear-clipped with the opening cut out, through the grid's nodes on its
+    border (the squares and the frame share their edges)."""
+    pts = np.concatenate(loops)
+    olo, ohi = pts.min(axis=0), pts.max(axis=0)
+    if spacing is None:
+        spacing = 0.25 * float(np.min(ohi - olo))
+    lower, upper = np.asarray(lower, float), np.asarray(upper, float)
+    nx = max(1, int(math.ceil((upper[0] - lower[0]) / spacing)))
+    ny = max(1, int(math.ceil((upper[1] - lower[1]) / spacing)))
+    xs, ys = np.linspace(lower[0], upper[0], nx + 1), np.linspace(lower[1], upper[1], ny + 1)
+    # The frame: the grid cells that the opening's box, one cell wider on each side, touches.
+    i0 = max(0, int(np.searchsorted(xs, olo[0], "right")) - 2)
+    i1 = min(nx, int(np.searchsorted(xs, ohi[0], "left")) + 1)
+    j0 = max(0, int(np.searchsorted(ys, olo[1], "right")) - 2)
+    j1 = min(ny, int(np.searchsorted(ys, ohi[1], "left")) + 1)
     for loop in loops:
         if not (np.all(loop[:, 0] > lower[0]) and np.all(loop[:, 0] < upper[0])
                 and np.all(loop[:, 1] > lower[1]) and np.all(loop[:, 1] < upper[1])):
             raise CavityError("the die's opening reaches the edge of the table: expected a table larger than the "
                               "opening on every side")
+    squares = []
+    for i in range(nx):
+        for j in range(ny):
+            if i0 <= i < i1 and j0 <= j < j1:
+                continue
+            a, b = np.array([xs[i], ys[j]]), np.array([xs[i + 1], ys[j]])
+            c, d = np.array([xs[i + 1], ys[j + 1]]), np.array([xs[i], ys[j + 1]])
+            squares += [(a, b, c), (a, c, d)]
+    frame = _outline(np.array([xs[i0], ys[j0]]), np.array([xs[i1], ys[j1]]), i1 - i0, j1 - j0)
+    rect = frame
     depth = [sum(_inside_loop(loop[0], other) for j, other in enumerate(loops) if j != i)
              for i, loop in enumerate(loops)]
     # Even depth: an outline of the opening (a hole of the table or of an island); odd: an island's edge.
@@ -285,5 +322,7 @@ def table_triangles(loops, lower, upper, z=0.0):
         if d % 2 == 1:
             inner = [l for l, dd in zip(loops, depth) if dd == d + 1 and _inside_loop(l[0], loop)]
             pieces.append(polygon_with_holes(loop, inner))
+    if squares:
+        pieces.append(np.array(squares))
     flat = np.concatenate(pieces)
     return np.concatenate([flat, np.full(flat.shape[:2] + (1,), z)], axis=2)
