@@ -10,7 +10,9 @@ Modules (one concept each):
     plots      PNG pictures (matplotlib, Agg)
     results    results.json + results.csv (write, or update: merged with what is there)
     closedmesh a closed STL surface (a die cavity): points inside, depth, volume per cell
+    cavity     a die cavity placed at the table, split into opening, floors and walls; the table
+    shoemotion a shoe's motion from a table of time and position (translation segments)
     output     output files that replace the old ones only once complete
 """
 __all__ = ["foamdict", "series", "summary", "geometry", "profile", "plate", "plots", "results", "output",
-           "closedmesh"]
+           "closedmesh", "cavity", "shoemotion"]
