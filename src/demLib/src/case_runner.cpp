@@ -20,6 +20,7 @@
 #include "demLib/error.hpp"
 #include "demLib/ghost_exchange.hpp"
 #include "demLib/liquid_bridges_over_ranks.hpp"
+#include "demLib/particle_message.hpp"
 
 namespace dem {
 
@@ -762,32 +763,12 @@ ParticleStore CaseRunner::gatheredParticles() const {
     const ParticleStore& p = simulation_->particles();
     std::vector<std::vector<char>> send(comm.size());
     ByteWriter out{send[0]};
-    for (std::size_t i = 0; i < simulation_->ownedCount(); ++i) {
-        out.put(p.id[i]);
-        out.put(p.position[i]);
-        out.put(p.velocity[i]);
-        out.put(p.omega[i]);
-        out.put(p.force[i]);
-        out.put(p.radius[i]);
-        out.put(p.mass[i]);
-        out.put(p.material[i]);
-    }
+    for (std::size_t i = 0; i < simulation_->ownedCount(); ++i) packParticle(out, p, i);
     const std::vector<std::vector<char>> received = comm.exchange(send);
     ParticleStore all;
     if (comm.rank() != 0) return all;
     for (const std::vector<char>& part : received)
-        for (ByteReader in{part}; !in.done();) {
-            all.id.push_back(in.get<std::int64_t>());
-            all.position.push_back(in.vec());
-            all.velocity.push_back(in.vec());
-            all.omega.push_back(in.vec());
-            all.force.push_back(in.vec());
-            all.torque.push_back(Vec3::Zero());
-            all.radius.push_back(in.get<double>());
-            all.mass.push_back(in.get<double>());
-            all.material.push_back(in.get<int>());
-            all.externalForce.push_back(Vec3::Zero());
-        }
+        for (ByteReader in{part}; !in.done();) unpackParticle(in, all);
     return all;
 }
 
