@@ -388,7 +388,7 @@ def write_case(case, path, rel, a):
     cohesion = ("" if water == 0 else
                 f"cohesion\n{{\n    model          capillary;\n    waterContent   {water:g};\n"
                 f"    surfaceTension 0.072;\n    contactAngle   0;\n}}\n")
-    regions = [f"        cavity {{ type stl; file \"constant/triSurface/cavity.stl\"; }}"]
+    regions = ["        cavity { type stl; file \"constant/triSurface/cavity.stl\"; }"]
     nx, ny = int(grid[0]), int(grid[1])
     for i in range(nx):
         for j in range(ny):
@@ -491,12 +491,10 @@ def write_air(case, cavity, table_lo, table_hi, lo, height, start, half, shoe_ty
     n_below = max(2, math.ceil(-lo[2] / cell) + 1)
     n_above = max(4, math.ceil(top / cell))
     z_lo = -n_below * cell
-    span = table_hi - table_lo
     # The background box inside the table by a fraction of a cell: the table cuts through it
     box_lo = table_lo + 0.3 * cell
     box_hi = table_hi - 0.3 * cell
     nx, ny = max(4, math.ceil((box_hi[0] - box_lo[0]) / cell)), max(4, math.ceil((box_hi[1] - box_lo[1]) / cell))
-    del span
     v = lambda x, y, z: f"({x:.9g} {y:.9g} {z:.9g})"
     z_top = n_above * cell
     verts = []
