@@ -8,7 +8,8 @@ powder, the steps of the rig) and writes, in DIR:
   constant/triSurface/  cavity.stl (the cavity, placed: opening at z = 0, centred), table.stl
                         (the table with the opening cut out), dieWalls.stl (lowered with the
                         table), dieFloors.stl (the punches: they stay), opening.stl, airWalls.stl
-                        (table + walls + floors: the air mesh's wall), shoe.stl (a box shoe)
+                        (table + walls + floors: the air mesh's wall), shoe.stl (a box or STL shoe's
+                        wall), shoeInside.stl (an STL shoe: its inside, the insertion region)
   constant/demProperties.orig  the DEM: walls from those STL files, the shoe's motion, insertion
                         in the shoe, the timeline, output regions (the cavity, the region grid)
   system/blockMeshDict, snappyHexMeshDict, meshQualityDict, topoSetDict, createPatchDict
@@ -32,7 +33,8 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _common import argument_parser, positive, run_main  # noqa: E402
 from diefillpost import foamdict, shoemotion  # noqa: E402
-from diefillpost.cavity import UNITS, Cavity, CavityError, table_triangles, write_stl  # noqa: E402
+from diefillpost.cavity import LARGEST_DIE, SMALLEST_DIE, UNITS, Cavity, CavityError, table_triangles, write_stl  # noqa: E402
+from diefillpost.shoe import Shoe, ShoeError  # noqa: E402
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PAPER_CASE = os.path.join(REPO, "tutorials", "dieFilling")
@@ -176,17 +178,6 @@ def shoe_path(motion, start_xy, scale, path):
     return segments, points
 
 
-def box_shoe_triangles(lx, ly, h):
-    """The four side walls of an open box shoe centred on x = y = 0, from z = 0 to h."""
-    c = [(-lx / 2, -ly / 2), (lx / 2, -ly / 2), (lx / 2, ly / 2), (-lx / 2, ly / 2)]
-    tris = []
-    for k in range(4):
-        (ax, ay), (bx, by) = c[k], c[(k + 1) % 4]
-        p = [np.array([ax, ay, 0.0]), np.array([bx, by, 0.0]), np.array([bx, by, h]), np.array([ax, ay, h])]
-        tris += [(p[0], p[1], p[2]), (p[0], p[2], p[3])]
-    return tris
-
-
 def fmt(v):
     return "(" + " ".join("%.9g" % x for x in v) + ")"
 
@@ -234,21 +225,36 @@ def write_case(case, path, rel, a):
     olo, ohi = cavity.opening_bounds()
     depth = -lo[2]
 
-    shoe = root.sub("shoe")
-    shoe_type = shoe.word("type", ["box", "cylinder"])
+    shoe_dict = root.sub("shoe")
+    shoe_type = shoe_dict.word("type", ["box", "cylinder", "stl"])
+    start = shoe_dict.vector("start", 2) * scale
     if shoe_type == "box":
-        shoe.check_keys(["type", "size", "start"])
-        size = shoe.vector("size", 3) * scale
+        shoe_dict.check_keys(["type", "size", "start"])
+        size = shoe_dict.vector("size", 3) * scale
         if np.any(size <= 0):
-            shoe.fail("size", "three lengths > 0", list(size / scale))
-        half = size[:2] / 2
-        height = size[2]
+            shoe_dict.fail("size", "three lengths > 0", list(size / scale))
+        shoe = Shoe.box(size, start)
+    elif shoe_type == "cylinder":
+        shoe_dict.check_keys(["type", "radius", "height", "start"])
+        radius = shoe_dict.number("radius", low=0.0, low_open=True) * scale
+        height = shoe_dict.number("height", low=0.0, low_open=True) * scale
+        shoe = Shoe.cylinder(radius, height, start)
     else:
-        shoe.check_keys(["type", "radius", "height", "start"])
-        radius = shoe.number("radius", low=0.0, low_open=True) * scale
-        height = shoe.number("height", low=0.0, low_open=True) * scale
-        half = np.array([radius, radius])
-    start = shoe.vector("start", 2) * scale
+        shoe_dict.check_keys(["type", "file", "start"])
+        given = shoe_dict.d.get("file")
+        if not isinstance(given, str):
+            shoe_dict.fail("file", 'the STL file of the shoe\'s inside, e.g. "constant/shoe.stl"', given)
+        shoe_file = given if os.path.isabs(given) else os.path.join(case, given)
+        if not os.path.isfile(shoe_file):
+            shoe_dict.fail("file", "an STL file that exists (relative to the case)", given)
+        try:
+            shoe = Shoe.from_stl(shoe_file, scale, start, given)
+        except ShoeError as e:
+            raise DictError(f"{rel}: shoe/file: {e}")
+        if not SMALLEST_DIE <= float(max(2 * shoe.half.max(), shoe.height)) <= LARGEST_DIE:
+            shoe_dict.fail("file", f"a shoe {SMALLEST_DIE * 1e3:g} mm to {LARGEST_DIE:g} m across in unit {unit} "
+                                   f"(it is {2 * shoe.half.max():.6g} x {shoe.height:.6g} m)", given)
+    half, height = shoe.half, shoe.height
     segments, points = shoe_path(root.sub("motion"), start, scale, path)
     path_xy = np.array([[p[1], p[2]] for p in points])
     # The shoe must pass over the opening: its footprint overlaps the opening's box at some time
@@ -265,8 +271,8 @@ def write_case(case, path, rel, a):
                                         f"{ohi[1] / scale:.4g} {unit})")
     start_inside = np.all(start - half < ohi[:2]) and np.all(start + half > olo[:2])
     if start_inside:
-        shoe.fail("start", "a start position where the shoe stands on the table beside the opening (it is filled "
-                           "there)", list(start / scale))
+        shoe_dict.fail("start", "a start position where the shoe stands on the table beside the opening (it is "
+                                "filled there)", list(start / scale))
     margin = 0.25 * max(half)
     table_lo = np.minimum(path_xy.min(axis=0) - half, olo[:2]) - margin
     table_hi = np.maximum(path_xy.max(axis=0) + half, ohi[:2]) + margin
@@ -303,13 +309,12 @@ def write_case(case, path, rel, a):
             named[name] = v * scale
 
     # The shoe's powder: fill height at a loose packing 0.55 must fit in the shoe
-    footprint = 4 * half[0] * half[1] if shoe_type == "box" else math.pi * half[0] ** 2
     bulk = 2650.0 * 0.55
-    fill_height = mass / (bulk * footprint)
-    if fill_height > 0.9 * height:
-        powder.fail("mass", f"at most {0.9 * height * bulk * footprint:.4g} kg: {mass:g} kg stands "
-                            f"{fill_height * 1e3:.3g} mm high in the shoe at a packing of 0.55, the shoe is "
-                            f"{height * 1e3:.3g} mm", mass)
+    if mass / bulk > 0.9 * shoe.volume:
+        powder.fail("mass", f"at most {0.9 * shoe.volume * bulk:.4g} kg: {mass:g} kg at a packing of 0.55 fills "
+                            f"{mass / bulk / shoe.volume * 100:.3g} % of the shoe's {shoe.volume * 1e6:.4g} cm3 "
+                            f"({mass / (bulk * shoe.area) * 1e3:.3g} mm high in a shoe of {height * 1e3:.3g} mm)",
+                    mass)
     # Timeline
     fill_end = 0.5 * segments[0][0] if segments[0][0] > 0 else 0.0
     pass_end = segments[-1][1]
@@ -327,7 +332,7 @@ def write_case(case, path, rel, a):
         "openingBounds_m": [list(map(float, olo[:2])), list(map(float, ohi[:2]))],
         "openingArea_m2": cavity.opening_area(), "tableBounds_m": [list(map(float, table_lo)), list(map(float, table_hi))],
         "shoe": {"type": shoe_type, "halfSize_m": list(map(float, half)), "height_m": float(height),
-                 "start_m": list(map(float, start))},
+                 "start_m": list(map(float, start)), "footprintArea_m2": shoe.area, "volume_m3": shoe.volume},
         "shoePath": [{"time_s": p[0], "x_m": p[1], "y_m": p[2]} for p in points],
         "timeline_s": {"shoeFilled": fill_end, "shoeMoves": segments[0][0], "shoeStops": pass_end,
                        "filled": open_start, "opening": open_start if lower else None,
@@ -351,16 +356,16 @@ def write_case(case, path, rel, a):
     write_stl(os.path.join(tri_dir, "dieFloors.stl"), "dieFloors", cavity.triangles(cavity.is_floor))
     write_stl(os.path.join(tri_dir, "airWalls.stl"), "walls",
               np.concatenate([table, cavity.triangles(cavity.is_wall), cavity.triangles(cavity.is_floor)]))
-    if shoe_type == "box":
-        write_stl(os.path.join(tri_dir, "shoe.stl"), "shoe",
-                  [tuple(p + np.array([start[0], start[1], 0.0]) for p in t)
-                   for t in box_shoe_triangles(2 * half[0], 2 * half[1], height)])
+    if shoe.wall_triangles() is not None:
+        write_stl(os.path.join(tri_dir, "shoe.stl"), "shoe", shoe.wall_triangles())
+    if shoe.region_triangles() is not None:
+        write_stl(os.path.join(tri_dir, "shoeInside.stl"), "shoeInside", shoe.region_triangles())
 
     # ---- constant/demProperties ----
     motion_lines = shoemotion.motion_block(segments)
     opening = (f"motion {{ open {{ type translate; start {open_start:.9g}; end {open_end:.9g}; "
                f"velocity (0 0 {-OPENING_SPEED:g}); }} }}" if lower else "")
-    if shoe_type == "box":
+    if shoe_type != "cylinder":
         shoe_wall = "type stl; file \"constant/triSurface/shoe.stl\"; material steel;   // at its start position"
     else:
         shoe_wall = (f"type cylinder; material steel; side inside;\n        axisPoint {fmt([start[0], start[1], 0.0])};"
@@ -369,6 +374,8 @@ def write_case(case, path, rel, a):
     if shoe_type == "box":
         region = (f"type box; min {fmt([start[0] - half[0] + inset, start[1] - half[1] + inset, 0.0005 * height])}; "
                   f"max {fmt([start[0] + half[0] - inset, start[1] + half[1] - inset, 0.98 * height])};")
+    elif shoe_type == "stl":
+        region = "type stl; file \"constant/triSurface/shoeInside.stl\";"
     else:
         region = (f"type cylinder; axisPoint {fmt([start[0], start[1], 0.0])}; axis (0 0 1); radius "
                   f"{half[0] - inset:.9g}; range ({0.0005 * height:.9g} {0.98 * height:.9g});")
@@ -470,8 +477,7 @@ output
     with open(os.path.join(case, "constant", "dieCase.json"), "w") as f:
         json.dump(summary, f, indent=1)
     if air:
-        write_air(case, cavity, table_lo, table_hi, lo, height, start, half, shoe_type, aeration, segments,
-                  end_time, grain)
+        write_air(case, cavity, table_lo, table_hi, lo, shoe, aeration, segments, end_time, grain)
     print(f"writeDieCase: {rel}: cavity {cavity.volume * 1e6:.4g} cm3, {depth * 1e3:.4g} mm deep, opening "
           f"{(ohi[0] - olo[0]) * 1e3:.4g} x {(ohi[1] - olo[1]) * 1e3:.4g} mm; shoe {shoe_type}, {len(segments)} "
           f"motion segment(s) {segments[0][0]:.4g}-{pass_end:.4g} s; {mass * 1e3:g} g at coarse grain {grain:g}; "
@@ -479,9 +485,9 @@ output
     return 0
 
 
-def write_air(case, cavity, table_lo, table_hi, lo, height, start, half, shoe_type, aeration, segments, end_time,
-              grain):
+def write_air(case, cavity, table_lo, table_hi, lo, shoe, aeration, segments, end_time, grain):
     system = os.path.join(case, "system")
+    start, half, height, shoe_type = shoe.start, shoe.half, shoe.height, shoe.kind
     # Air cells: three of the largest parcels across, or 8 across the opening's smaller side where
     # that is finer, but never smaller than a parcel (unresolved coupling: a cell holds parcels).
     olo, ohi = cavity.opening_bounds()
@@ -569,6 +575,13 @@ mergeTolerance 1e-6;
     if shoe_type == "box":
         under = (f"source boxToFace; box {v(start[0] - half[0] + 0.25 * cell, start[1] - half[1] + 0.25 * cell, -0.5 * cell)} "
                  f"{v(start[0] + half[0] - 0.25 * cell, start[1] + half[1] - 0.25 * cell, 0.5 * cell)};")
+    elif shoe_type == "stl":
+        # The table's faces under the shoe, row by row of the background mesh (boxToFace tests face centres)
+        xs = box_lo[0] + (np.arange(nx) + 0.5) * (box_hi[0] - box_lo[0]) / nx
+        ys = box_lo[1] + (np.arange(ny) + 0.5) * (box_hi[1] - box_lo[1]) / ny
+        boxes = shoe.boxes_over(xs, ys, 0.25 * cell)
+        under = "source boxToFace; boxes (" + " ".join(
+            f"{v(a[0], a[1], -0.5 * cell)} {v(b[0], b[1], 0.5 * cell)}" for a, b in boxes) + ");"
     else:
         under = (f"source cylinderToFace; p1 {v(start[0], start[1], -0.5 * cell)}; p2 {v(start[0], start[1], 0.5 * cell)}; "
                  f"radius {r - 0.75 * cell:.9g};")

@@ -4,6 +4,7 @@ tools/writeDieCase.py) against numbers known by construction.  One line per chec
 import json
 import math
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -13,6 +14,7 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(ROOT, "tools"))
 from diefillpost.cavity import Cavity, CavityError, table_triangles, write_stl  # noqa: E402
+from diefillpost.shoe import Shoe, ShoeError  # noqa: E402
 import writeDieStl  # noqa: E402
 
 PY = sys.executable
@@ -185,6 +187,69 @@ results { regionGrid (2 2); regions { near (-20 -20 0 20); } }
           rc == 0 and "start 0.5; end 1.5; velocity (0.06 0 0)" in dem and "start 1.5; end 2.5; velocity (0.04 0 0)" in dem,
           out.strip()[-200:])
 
+    # A shoe of any shape: the closed STL surface of its inside (diefillpost/shoe.py)
+    octagon = os.path.join(tmp, "octagonShoe.stl")
+    write_stl(octagon, "octagonShoe", [np.asarray(x, float) for x in writeDieStl.cylinder(25.0, 30.0, 8)])
+    sh = Shoe.from_stl(octagon, 1e-3, (-0.045, 0.01))
+    wall, inside = sh.wall_triangles(), sh.region_triangles()
+    check("STL shoe (octagon R = 25 mm, 30 mm high): footprint area 2 sqrt(2) R^2, volume area x height",
+          abs(sh.area - polygon_area(8, 0.025)) < 1e-12 and abs(sh.volume - polygon_area(8, 0.025) * 0.03) < 1e-12,
+          f"{sh.area * 1e6:.6f} mm2, {sh.volume * 1e6:.6f} cm3")
+    check("STL shoe: placed with its bottom on the table (z = 0) and its footprint's box centred on the start",
+          abs(inside[:, :, 2].min()) < 1e-15 and abs(inside[:, :, 2].max() - 0.03) < 1e-12
+          and np.allclose(0.5 * (inside[:, :, :2].reshape(-1, 2).min(0) + inside[:, :, :2].reshape(-1, 2).max(0)),
+                          [-0.045, 0.01], atol=1e-12))
+    check("STL shoe: the wall is the surface without its 8 bottom faces (open on the table), the lid kept",
+          len(inside) - len(wall) == 8 and np.all(wall[:, :, 2].max(axis=1) > 1e-9))
+    probe = np.array([[-0.045, 0.01], [-0.045 + 0.022, 0.01], [-0.045 + 0.0245, 0.01], [-0.045 + 0.0185, 0.0285],
+                      [-0.045 + 0.016, 0.026]])
+    check("STL shoe: the table under it is the octagon (a corner's tip and an edge's midpoint told apart)",
+          list(sh.covers(probe)) == [True, True, True, False, True], str(sh.covers(probe)))
+    corners, quads = writeDieStl._box((-0.02, -0.015, 0.0), (0.02, 0.015, 0.025))
+    write_stl(os.path.join(tmp, "boxShoe.stl"), "boxShoe",
+              [corners[[q[0], q[1 + k], q[2 + k]]] for q in quads for k in (0, 1)])
+    boxed = Shoe.from_stl(os.path.join(tmp, "boxShoe.stl"), 1.0, (0.0, 0.0))
+    box = Shoe.box((0.04, 0.03, 0.025), (0.0, 0.0))
+    area = lambda t: float(0.5 * np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1).sum())
+    sides = np.array([t for t in boxed.wall_triangles() if np.ptp(t[:, 2]) > 0])
+    grid = np.linspace(-0.03, 0.03, 13)
+    check("an STL box shoe is the box shoe: the same footprint, volume, table faces under it, side walls",
+          np.allclose(boxed.half, box.half) and abs(boxed.volume - box.volume) < 1e-15
+          and abs(boxed.area - box.area) < 1e-15
+          and boxed.boxes_over(grid, grid, 0.001) == box.boxes_over(grid, grid, 0.001)
+          and len(box.boxes_over(grid, grid, 0.001)) == 5
+          and abs(area(sides) - area(box.wall_triangles())) < 1e-15
+          and abs(area(boxed.wall_triangles()) - area(sides) - 0.04 * 0.03) < 1e-15,
+          f"{len(box.boxes_over(grid, grid, 0.001))} rows under the box")
+    with open(octagon) as f:
+        lines = f.read().splitlines()
+    open_shoe = os.path.join(tmp, "openShoe.stl")
+    first = min(i for i, line in enumerate(lines) if line.strip().startswith("facet"))
+    with open(open_shoe, "w") as f:
+        f.write("\n".join(lines[:first] + lines[first + 7:]) + "\n")
+    try:
+        Shoe.from_stl(open_shoe, 1e-3, (0, 0))
+        check("an open shoe STL is refused", False)
+    except ShoeError as e:
+        check("an open shoe STL is refused, naming the file and 'not a closed surface'",
+              "openShoe.stl" in str(e) and "closed" in str(e), str(e)[:120])
+
+    shutil.copy(octagon, os.path.join(case, "constant", "octagonShoe.stl"))
+    shutil.copy(open_shoe, os.path.join(case, "constant", "openShoe.stl"))
+    stl_shoe = good.replace("shoe { type box; size (50 50 30); start (-50 0); }",
+                            'shoe { type stl; file "constant/octagonShoe.stl"; start (-50 0); }')
+    write_dict(stl_shoe)
+    rc, out = run([os.path.join(ROOT, "tools", "writeDieCase.py"), "-case", case], tmp)
+    dem = open(os.path.join(case, "constant", "demProperties.orig")).read()
+    topo = open(os.path.join(case, "system", "topoSetDict")).read()
+    summary = json.load(open(os.path.join(case, "constant", "dieCase.json")))
+    check("writeDieCase with an STL shoe: its wall (shoe.stl) moves, the powder is inserted in its inside "
+          "(shoeInside.stl), aeration under its footprint (boxToFace boxes)",
+          rc == 0 and 'type stl; file "constant/triSurface/shoe.stl"' in dem
+          and 'region   { type stl; file "constant/triSurface/shoeInside.stl"; }' in dem
+          and "source boxToFace; boxes (" in topo and summary["shoe"]["type"] == "stl"
+          and abs(summary["shoe"]["footprintArea_m2"] - polygon_area(8, 0.025)) < 1e-12, out.strip()[-200:])
+
     bad = [
         ("a misspelt keyword", good.replace("passes 2;", "pases 2;"), "motion/pases"),
         ("an unknown shoe type", good.replace("type box;", "type sphere;"), "shoe/type"),
@@ -195,6 +260,10 @@ results { regionGrid (2 2); regions { near (-20 -20 0 20); } }
         ("a stamp (not supported yet)", good.replace("lowerDieWall yes;", "lowerDieWall yes; stamp yes;"), "steps/stamp"),
         ("a wrong unit", good.replace("unit mm;", "unit m;"), "across"),
         ("an STL that does not exist", good.replace("ring.stl", "rign.stl"), "die/cavity"),
+        ("a shoe STL that does not exist", stl_shoe.replace("octagonShoe.stl", "octagon.stl"), "shoe/file"),
+        ("an open shoe STL", stl_shoe.replace("octagonShoe.stl", "openShoe.stl"), "not a closed surface"),
+        ("a shoe STL with a box's keyword", stl_shoe.replace("start (-50 0); }", "start (-50 0); size (1 1 1); }"),
+         "shoe/size"),
     ]
     for what, text, key in bad:
         write_dict(text)
