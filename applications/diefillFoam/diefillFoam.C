@@ -37,6 +37,7 @@ Description
 
 #include "demCoupling.H"
 #include "parallelLaunch.H"
+#include "phaseTimes.H"
 #include "progressReport.H"
 #include "stopSignal.H"
 
@@ -97,6 +98,8 @@ int main(int argc, char *argv[])
     // A line with the ETA every 30 s of wall time (long die-filling runs)
     diefill::progressReport progress(runTime);
     diefill::stopSignal stop;
+    // Where the wall time goes (printed at the end)
+    diefill::phaseTimes phases;
 
     while (runTime.run())
     {
@@ -109,7 +112,9 @@ int main(int argc, char *argv[])
         Info<< "Time = " << runTime.timeName() << nl << endl;
 
         // --- Particles to the new time, then their volume and drag to the air
+        phases.start(phases.dem);
         coupling.evolve();
+        phases.start(phases.coupling);
         coupling.updateVoidFraction();
         alphaf = fvc::interpolate(alpha);
         alphaPhi = alphaf*phi;
@@ -125,6 +130,7 @@ int main(int argc, char *argv[])
         coupling.updateExchange(Ksp, KUp);
 
         // --- Pressure-velocity PIMPLE corrector loop
+        phases.start(phases.air);
         while (pimple.loop())
         {
             #include "UEqn.H"
@@ -143,13 +149,16 @@ int main(int argc, char *argv[])
         }
 
         // --- The air's new state to the particles for the next DEM interval
+        phases.start(phases.coupling);
         coupling.updateParticleForces(Ksp, KUp);
 
+        phases.start(phases.output);
         if (runTime.writeTime())
         {
             coupling.write();
         }
         runTime.write();
+        phases.stop();
 
         runTime.printExecutionTime(Info);
 
@@ -167,6 +176,7 @@ int main(int argc, char *argv[])
 
     // The end time is written even when it is not a multiple of writeInterval,
     // with the particle forces that go with it (a later continuation needs both)
+    phases.start(phases.output);
     if (!runTime.writeTime())
     {
         runTime.writeNow();
@@ -174,6 +184,8 @@ int main(int argc, char *argv[])
     }
 
     coupling.finish();
+    phases.stop();
+    phases.report(Info(), coupling.demExchangeSeconds());
 
     if (stop.requested())
     {

@@ -5,6 +5,7 @@ measured and what was expected, and exits 0 (pass) or 1 (fail).
   terminal LOG RHO_P RHO_F MU D G [LAW]     terminal velocity vs the force balance
                                              with LAW's single-sphere drag
                                              (SchillerNaumann, default, or Dallavalle)
+  phases LOG RANKS                           the wall-time table at the end adds up
   balance LOG                                the exchange terms handed to the air
                                              (air's loss) == the drag on the particles:
                                              the weights of each particle's share over
@@ -363,6 +364,38 @@ def same(args):
     return ok
 
 
+def phases(args):
+    """The wall-time table at the end of the log (phaseTimes): the four phases and the
+    rest add up to the time loop's wall time (each row rounded to 4 digits), the DEM's
+    exchanges lie within the DEM's time, each rank's figures within their least-most
+    range; RANKS: 1 (serial) or the rank count named in the header."""
+    log, ranks = args[0], int(args[1])
+    text = open(log).read()
+    m = re.search(r"Wall time of the time loop, ([0-9.e+-]+) s(?: \((\d+) ranks[^)]*\))?:\n((?:    .*\n)+)", text)
+    if not m:
+        print("    no 'Wall time of the time loop' table in", log)
+        return False
+    total, named = float(m.group(1)), int(m.group(2) or 1)
+    rows = {}
+    for line in m.group(3).splitlines():
+        r = re.match(r"\s{4}\s*(\S.*?)\s+([0-9.e+-]+) s\s+([0-9.]+) %(?:\s+\(([0-9.e+-]+) - ([0-9.e+-]+) s\))?", line)
+        if r:
+            rows[r.group(1).strip()] = [float(x) for x in r.groups()[1:] if x is not None]
+    phases = ["DEM (particle steps)", "coupling (void fraction, drag)", "air (PIMPLE loop)",
+              "output (fields, restart files)", "rest (time control, progress)"]
+    have = all(p in rows for p in phases)
+    # Decomposed, each row is the most over ranks: their sum is at least the loop's time
+    # of the slowest rank less its idle share; serially the rows are one rank's and add up.
+    added = sum(rows[p][0] for p in phases) if have else float("nan")
+    sums = abs(added - total) <= 2e-3 * total + 1e-3 if ranks == 1 else added >= 0.999 * total - 1e-3
+    exchange = rows.get("of which in the DEM's exchanges")
+    within = ranks == 1 or (exchange is not None and exchange[0] <= rows["DEM (particle steps)"][0] * 1.0001 + 1e-4
+                            and all(r[2] <= r[3] * (1 + 1e-9) for r in rows.values()))
+    print(f"    {len(rows)} rows, {named} rank(s) named (expected {ranks}); phases add up to {added:.4g} s "
+          f"against the loop's {total:.4g} s; DEM exchanges {exchange[0] if exchange else '-'} s")
+    return have and named == ranks and sums and within
+
+
 def forces(args):
     """Two particle-force files of a decomposed run (restart_<step>.h5.forces: id,
     force), the same particles with the same forces to TOL of the largest."""
@@ -382,5 +415,5 @@ def forces(args):
 if __name__ == "__main__":
     command = {"terminal": terminal, "balance": balance, "ergun": ergun, "centre": centre,
                "fluidisation": fluidisation, "identical": identical, "same": same,
-               "forces": forces}[sys.argv[1]]
+               "forces": forces, "phases": phases}[sys.argv[1]]
     sys.exit(0 if command(sys.argv[2:]) else 1)

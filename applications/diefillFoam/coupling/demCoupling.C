@@ -706,9 +706,19 @@ void Foam::diefill::demCoupling::readForcesById(const std::string& file)
 }
 
 
+double Foam::diefill::demCoupling::communicatorSeconds() const
+{
+    const auto* decomposition = runner_->simulation().decomposition();
+    return decomposition ? decomposition->communicator().counters().seconds : 0.0;
+}
+
+
 void Foam::diefill::demCoupling::evolve()
 {
     demStepsPerFluidStep();
+    // The coupling's own exchanges go through the same communicator: only
+    // the time inside the DEM's steps counts here
+    const double before = communicatorSeconds();
     try
     {
         sigFpe::ignore noTrapping;
@@ -720,6 +730,7 @@ void Foam::diefill::demCoupling::evolve()
             << "The DEM failed:" << nl << "    " << e.what()
             << exit(FatalError);
     }
+    demExchangeSeconds_ += communicatorSeconds() - before;
 }
 
 
