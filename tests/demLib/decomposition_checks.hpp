@@ -47,6 +47,38 @@ inline void collectivesAgree(const dem::Communicator& c) {
     }
 }
 
+// The step's round (exchangeKnownSizesAndAnyTrue): rank r sends 3 (r + 1) +
+// destination bytes of value (10 r + destination) to every other rank (none
+// to rank 0 from the last rank, which rank 0 then expects), each rank knowing
+// what it gets; the flag is the logical or over the ranks.
+inline void knownSizeExchangeAgrees(const dem::Communicator& c) {
+    const int rank = c.rank();
+    const int size = c.size();
+    auto bytes = [&](int from, int to) -> std::size_t {
+        if (from == to) return 0;
+        if (from == size - 1 && to == 0) return 0;
+        return static_cast<std::size_t>(3 * (from + 1) + to);
+    };
+    for (int round = 0; round < 3; ++round) {
+        std::vector<std::vector<char>> send(size);
+        std::vector<std::size_t> sizes(size);
+        for (int r = 0; r < size; ++r) {
+            send[r].assign(bytes(rank, r), static_cast<char>(10 * rank + r));
+            sizes[r] = bytes(r, rank);
+        }
+        // Round 0: only the last rank raises the flag; round 1: none; round 2: all.
+        const bool flag = round == 2 || (round == 0 && rank == size - 1);
+        const auto got = c.exchangeKnownSizesAndAnyTrue(send, sizes, flag);
+        EXPECT_EQ(got.anyTrue, round != 1) << "round " << round;
+        ASSERT_EQ(static_cast<int>(got.received.size()), size);
+        for (int from = 0; from < size; ++from) {
+            if (from == rank) continue;
+            EXPECT_EQ(got.received[from].size(), bytes(from, rank)) << "from rank " << from;
+            for (char b : got.received[from]) EXPECT_EQ(b, static_cast<char>(10 * from + rank));
+        }
+    }
+}
+
 struct Runs {
     dem::Simulation serial;
     dem::Simulation decomposed;

@@ -353,6 +353,7 @@ TEST(ThreadRanks, CollectivesGiveEveryRankTheSameResults) {
             seen += 1 << c.rank();
             for (int round = 0; round < 50; ++round) {
                 decomposition_checks::collectivesAgree(c);
+                decomposition_checks::knownSizeExchangeAgrees(c);
                 // A rank that runs ahead must not change what a slower one
                 // still reads: values change with every call.
                 const double mine = round * 100.0 + c.rank();
@@ -363,6 +364,24 @@ TEST(ThreadRanks, CollectivesGiveEveryRankTheSameResults) {
         EXPECT_EQ(seen.load(), (1 << ranks) - 1) << "each rank ran once";
     }
     EXPECT_THROW(dem::Communicator::runThreadGroup(0, [](const dem::Communicator&) {}), dem::InputError);
+}
+
+// The known-size exchange refuses a message of another size than announced,
+// naming the rank it came from.
+TEST(ThreadRanks, KnownSizeExchangeRefusesAnUnannouncedSize) {
+    try {
+        dem::Communicator::runThreadGroup(2, [](const dem::Communicator& c) {
+            std::vector<std::vector<char>> send(2);
+            send[1 - c.rank()].assign(4, 'x');
+            const std::vector<std::size_t> sizes = c.rank() == 0 ? std::vector<std::size_t>{0, 5}
+                                                                 : std::vector<std::size_t>{4, 0};
+            c.exchangeKnownSizesAndAnyTrue(send, sizes, false);
+        });
+        FAIL() << "expected an error";
+    } catch (const dem::RuntimeError& e) {
+        EXPECT_NE(std::string(e.what()).find("rank 1 sent 4 bytes"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("expected 5"), std::string::npos) << e.what();
+    }
 }
 
 // The communication counters: the bytes sent to other ranks by exchange and

@@ -67,8 +67,9 @@ void check(int code, const char* what) {
     if (code != MPI_SUCCESS) throw RuntimeError(std::string("demLib communicator: ") + what + " failed");
 }
 
-// demLib's point-to-point messages use this tag on the caller's communicator.
+// demLib's point-to-point messages use these tags on the caller's communicator.
 constexpr int exchangeTag = 7331;
+constexpr int knownSizeTag = 7332;
 
 }  // namespace
 
@@ -153,6 +154,64 @@ std::vector<std::vector<char>> processExchange(const Communicator& c, const std:
     return received;
 }
 
+// exchangeKnownSizesAndAnyTrue between the ranks of an MPI communicator of
+// more than one rank: the reduction and the messages posted together, one wait.
+Communicator::ExchangeAndFlag processExchangeKnownSizes(const Communicator& c,
+                                                        const std::vector<std::vector<char>>& sendTo,
+                                                        const std::vector<std::size_t>& receiveSizes, bool flag) {
+    const int size = c.size();
+    const int rank = c.rank();
+    const MPI_Comm comm = c.mpiHandle()->comm;
+    Communicator::ExchangeAndFlag out;
+    out.received.resize(size);
+    std::vector<MPI_Request> requests;
+    requests.reserve(2 * size + 1);
+    const std::int64_t mine = flag ? 1 : 0;
+    std::int64_t any = 0;
+    requests.emplace_back();
+    check(MPI_Iallreduce(&mine, &any, 1, MPI_INT64_T, MPI_LOR, comm, &requests.back()), "MPI_Iallreduce");
+    std::vector<int> from;
+    for (int r = 0; r < size; ++r) {
+        if (r == rank) {
+            out.received[r] = sendTo[r];
+            continue;
+        }
+        if (receiveSizes[r] > static_cast<std::size_t>(std::numeric_limits<int>::max()) ||
+            sendTo[r].size() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+            throw RuntimeError("demLib communicator: a message of more than 2 GiB; expected smaller subdomains");
+        if (receiveSizes[r] == 0) continue;
+        out.received[r].resize(receiveSizes[r]);
+        requests.emplace_back();
+        from.push_back(r);
+        check(MPI_Irecv(out.received[r].data(), static_cast<int>(receiveSizes[r]), MPI_BYTE, r, knownSizeTag, comm,
+                        &requests.back()),
+              "MPI_Irecv");
+    }
+    for (int r = 0; r < size; ++r) {
+        if (r == rank || sendTo[r].empty()) continue;
+        requests.emplace_back();
+        check(MPI_Isend(sendTo[r].data(), static_cast<int>(sendTo[r].size()), MPI_BYTE, r, knownSizeTag, comm,
+                        &requests.back()),
+              "MPI_Isend");
+    }
+    std::vector<MPI_Status> statuses(requests.size());
+    // A message longer than announced fails here (MPI_ERR_TRUNCATE) ...
+    if (MPI_Waitall(static_cast<int>(requests.size()), requests.data(), statuses.data()) != MPI_SUCCESS)
+        throw RuntimeError("demLib communicator: a message of the known-size exchange did not arrive as announced "
+                           "(longer than expected?)");
+    // ... a shorter one here.
+    for (std::size_t k = 0; k < from.size(); ++k) {
+        int count = 0;
+        MPI_Get_count(&statuses[k + 1], MPI_BYTE, &count);
+        if (static_cast<std::size_t>(count) != receiveSizes[from[k]])
+            throw RuntimeError("demLib communicator: rank " + std::to_string(from[k]) + " sent " +
+                               std::to_string(count) + " bytes in the known-size exchange; expected " +
+                               std::to_string(receiveSizes[from[k]]));
+    }
+    out.anyTrue = any != 0;
+    return out;
+}
+
 }  // namespace
 
 #else  // serial build: the only process-level communicator is the one-process group
@@ -201,6 +260,40 @@ std::vector<std::vector<char>> Communicator::exchange(const std::vector<std::vec
     for (int r = 0; r < size_; ++r)
         if (r != rank_) c.exchangeBytes += static_cast<std::int64_t>(sendTo[static_cast<std::size_t>(r)].size());
     return received;
+}
+
+Communicator::ExchangeAndFlag Communicator::exchangeKnownSizesAndAnyTrue(const std::vector<std::vector<char>>& sendTo,
+                                                                       const std::vector<std::size_t>& receiveSizes,
+                                                                       bool flag) const {
+    if (static_cast<int>(sendTo.size()) != size_ || static_cast<int>(receiveSizes.size()) != size_)
+        throw RuntimeError("demLib communicator: known-size exchange given " + std::to_string(sendTo.size()) +
+                           " buffers and " + std::to_string(receiveSizes.size()) + " sizes; expected one per rank (" +
+                           std::to_string(size_) + ")");
+    ExchangeAndFlag out;
+#if DEMLIB_HAS_MPI
+    if (!threads_ && usesMpi() && size_ > 1) {
+        const auto start = std::chrono::steady_clock::now();
+        out = processExchangeKnownSizes(*this, sendTo, receiveSizes, flag);
+        CommunicationCounters& c = *counters_;
+        c.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        ++c.exchangeCalls;
+        ++c.reductionCalls;
+        c.reductionBytes += static_cast<std::int64_t>(sizeof(std::int64_t)) * (size_ - 1);
+        for (int r = 0; r < size_; ++r)
+            if (r != rank_) c.exchangeBytes += static_cast<std::int64_t>(sendTo[static_cast<std::size_t>(r)].size());
+        return out;
+    }
+#endif
+    // Thread ranks and the one-process group: the two collectives one after the other.
+    out.anyTrue = anyTrue(flag);
+    out.received = exchange(sendTo);
+    for (int r = 0; r < size_; ++r)
+        if (r != rank_ && out.received[static_cast<std::size_t>(r)].size() != receiveSizes[static_cast<std::size_t>(r)])
+            throw RuntimeError("demLib communicator: rank " + std::to_string(r) + " sent " +
+                               std::to_string(out.received[static_cast<std::size_t>(r)].size()) +
+                               " bytes in the known-size exchange; expected " +
+                               std::to_string(receiveSizes[static_cast<std::size_t>(r)]));
+    return out;
 }
 
 }  // namespace dem

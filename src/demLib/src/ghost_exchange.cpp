@@ -12,6 +12,12 @@
 namespace dem {
 
 namespace {
+// A ghost update per particle: position, velocity, spin.
+constexpr std::size_t ghostUpdateBytes = 9 * sizeof(double);
+}  // namespace
+
+
+namespace {
 
 void packHistory(ByteWriter& w, const ContactHistory& h) {
     w.put(h.shear);
@@ -55,6 +61,8 @@ GhostExchange::GhostExchange(Communicator communicator, SlabDecomposition slabs,
     setRebalanceThreshold(rebalanceThreshold);
     sendList_.assign(communicator_.size(), {});
     receiveCount_.assign(communicator_.size(), 0);
+    updateSendBytes_.assign(communicator_.size(), 0);
+    updateReceiveBytes_.assign(communicator_.size(), 0);
 }
 
 void GhostExchange::setSlabs(SlabDecomposition slabs) {
@@ -275,14 +283,19 @@ void GhostExchange::appendGhosts(ParticleStore& p, double haloWidth) {
         }
     }
     ghostCount_ = p.size() - owned;
+    for (int r = 0; r < ranks; ++r) {
+        updateSendBytes_[r] = r == me ? 0 : sendList_[r].size() * ghostUpdateBytes;
+        updateReceiveBytes_[r] = r == me ? 0 : receiveCount_[r] * ghostUpdateBytes;
+    }
 }
 
-void GhostExchange::updateGhosts(ParticleStore& p) const {
+std::vector<std::vector<char>> GhostExchange::packGhostUpdates(const ParticleStore& p) const {
     const int ranks = communicator_.size();
     const int me = rank();
     std::vector<std::vector<char>> send(ranks);
     for (int r = 0; r < ranks; ++r) {
         if (r == me || sendList_[r].empty()) continue;
+        send[r].reserve(sendList_[r].size() * ghostUpdateBytes);
         ByteWriter w{send[r]};
         for (int i : sendList_[r]) {
             w.put(p.position[i]);
@@ -290,7 +303,12 @@ void GhostExchange::updateGhosts(ParticleStore& p) const {
             w.put(p.omega[i]);
         }
     }
-    const std::vector<std::vector<char>> received = communicator_.exchange(send);
+    return send;
+}
+
+void GhostExchange::unpackGhostUpdates(ParticleStore& p, const std::vector<std::vector<char>>& received) const {
+    const int ranks = communicator_.size();
+    const int me = rank();
     std::size_t g = ownedCount(p);
     for (int r = 0; r < ranks; ++r) {
         if (r == me) continue;
@@ -304,6 +322,29 @@ void GhostExchange::updateGhosts(ParticleStore& p) const {
             throw RuntimeError("demLib ghost exchange: rank " + std::to_string(r) +
                                " sent a ghost update of the wrong size");
     }
+}
+
+void GhostExchange::updateGhosts(ParticleStore& p) const {
+    unpackGhostUpdates(p, communicator_.exchange(packGhostUpdates(p)));
+}
+
+bool GhostExchange::updateGhostsUnlessRebuild(ParticleStore& p, bool rebuildHere) const {
+    // The update travels even when a rebuild follows (then it is dropped): the
+    // flag and the messages share one wait, and a rebuild is rare.  Every rank
+    // sends and expects the sizes of the last ghost build (appendGhosts, all
+    // ranks together); a rank that has dropped its ghosts since (a particle
+    // lost) needs a rebuild and sends zeros of those sizes.
+    std::vector<std::vector<char>> send = packGhostUpdates(p);
+    for (int r = 0; r < communicator_.size(); ++r) {
+        if (send[r].size() == updateSendBytes_[r]) continue;
+        if (!rebuildHere)
+            throw RuntimeError("demLib ghost exchange: the ghost lists changed since the last build without a rebuild");
+        send[r].assign(updateSendBytes_[r], 0);
+    }
+    const Communicator::ExchangeAndFlag round =
+        communicator_.exchangeKnownSizesAndAnyTrue(send, updateReceiveBytes_, rebuildHere);
+    if (!round.anyTrue) unpackGhostUpdates(p, round.received);
+    return round.anyTrue;
 }
 
 void GhostExchange::restoreHistory(const ParticleStore& p, ParticleParticleNeighborList& pairs,

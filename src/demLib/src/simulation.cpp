@@ -713,9 +713,9 @@ void Simulation::step(long steps) {
         removeLostParticles(domainTested && !drifting.leftDomain);
         bool rebuild = last_.lostThisStep > 0 || (watched ? drifting.movedFar : pairs_.needsRebuild(particles_));
         if (decomposition_) {
-            // All ranks rebuild together (the rebuild exchanges particles).
-            rebuild = decomposition_->communicator().anyTrue(rebuild);
-            if (!rebuild) decomposition_->updateGhosts(particles_);
+            // All ranks rebuild together (the rebuild exchanges particles); the
+            // test and the ghost update share one round.
+            rebuild = decomposition_->updateGhostsUnlessRebuild(particles_, rebuild);
         }
         if (rebuild) updatePairList();
         computeForces(fused);  // a drift (this step's or the last one's) came first

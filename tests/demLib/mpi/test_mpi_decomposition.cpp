@@ -34,6 +34,7 @@ TEST(MpiCommunicator, WrapsTheCallersCommunicator) {
     EXPECT_EQ(c.rank(), rank);
     EXPECT_EQ(c.size(), size);
     collectivesAgree(c);
+    knownSizeExchangeAgrees(c);
 }
 
 TEST(MpiDecomposition, GhostsGiveTheSerialContactForces) {

@@ -76,6 +76,21 @@ public:
     // case), the result's element r is what rank r sent here.  Collective.
     std::vector<std::vector<char>> exchange(const std::vector<std::vector<char>>& sendTo) const;
 
+    // The two things a decomposed step needs from the other ranks, in one
+    // round: the exchange of sendTo as exchange() does it, where each rank
+    // already knows how many bytes it gets from each other rank
+    // (receiveSizes[r]; 0: nothing from r, and r sends nothing), and
+    // anyTrue(flag).  With MPI the reduction and the messages travel together
+    // (MPI_Iallreduce beside the point-to-point messages, one wait), instead of
+    // the three waits of anyTrue and exchange (sizes first, then data).
+    // A message of another size than announced is an error.  Collective.
+    struct ExchangeAndFlag {
+        std::vector<std::vector<char>> received;
+        bool anyTrue = false;
+    };
+    ExchangeAndFlag exchangeKnownSizesAndAnyTrue(const std::vector<std::vector<char>>& sendTo,
+                                                 const std::vector<std::size_t>& receiveSizes, bool flag) const;
+
     // This rank's traffic and time in the collectives above.  A communicator
     // and its copies share one set of counters (e.g. the copy a GhostExchange
     // holds and the caller's); each rank of a group counts its own, and each

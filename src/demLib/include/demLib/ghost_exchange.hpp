@@ -74,6 +74,13 @@ public:
     // step between list builds).  Collective.
     void updateGhosts(ParticleStore& particles) const;
 
+    // The rebuild test and the ghost update of one step in one round
+    // (Communicator::exchangeKnownSizesAndAnyTrue): returns whether any rank
+    // needs a rebuild (rebuildHere on some rank); when none does, the ghosts
+    // got their owners' new state as from updateGhosts, else they are left
+    // as they were (the rebuild replaces them).  Collective.
+    bool updateGhostsUnlessRebuild(ParticleStore& particles, bool rebuildHere) const;
+
     // Stash entries (global ids; history defined for particle `first`).
     struct PairRecord {
         std::int64_t first, second;  // first < second
@@ -138,8 +145,15 @@ private:
     SlabDecomposition slabs_;
     std::size_t ghostCount_ = 0;
     std::size_t migrated_ = 0;
+    // The ghost updates to send (per rank), and the received ones into the ghosts.
+    std::vector<std::vector<char>> packGhostUpdates(const ParticleStore& particles) const;
+    void unpackGhostUpdates(ParticleStore& particles, const std::vector<std::vector<char>>& received) const;
+
     std::vector<std::vector<int>> sendList_;  // per rank: owned indices sent as ghosts
     std::vector<std::size_t> receiveCount_;   // per rank: ghosts received from it
+    // Per rank: the bytes of a ghost update sent to it and received from it,
+    // as of the last ghost build (kept when a rank drops its ghosts alone).
+    std::vector<std::size_t> updateSendBytes_, updateReceiveBytes_;
     std::vector<PairRecord> pairStash_;
     std::vector<WallRecord> wallStash_;
     double rebalanceThreshold_ = defaultRebalanceThreshold;
