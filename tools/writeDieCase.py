@@ -356,10 +356,11 @@ def write_case(case, path, rel, a):
     write_stl(os.path.join(tri_dir, "dieFloors.stl"), "dieFloors", cavity.triangles(cavity.is_floor))
     write_stl(os.path.join(tri_dir, "airWalls.stl"), "walls",
               np.concatenate([table, cavity.triangles(cavity.is_wall), cavity.triangles(cavity.is_floor)]))
-    if shoe.wall_triangles() is not None:
-        write_stl(os.path.join(tri_dir, "shoe.stl"), "shoe", shoe.wall_triangles())
-    if shoe.region_triangles() is not None:
-        write_stl(os.path.join(tri_dir, "shoeInside.stl"), "shoeInside", shoe.region_triangles())
+    shoe_wall_triangles, shoe_inside = shoe.wall_triangles(), shoe.region_triangles()
+    if shoe_wall_triangles is not None:
+        write_stl(os.path.join(tri_dir, "shoe.stl"), "shoe", shoe_wall_triangles)
+    if shoe_inside is not None:
+        write_stl(os.path.join(tri_dir, "shoeInside.stl"), "shoeInside", shoe_inside)
 
     # ---- constant/demProperties ----
     motion_lines = shoemotion.motion_block(segments)

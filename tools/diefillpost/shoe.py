@@ -101,8 +101,8 @@ class Shoe:
             return np.linalg.norm(rel, axis=1) <= self.half[0] - inset
         z = np.full((len(xy), 1), 1e-3 * self.height)
         ok = self._mesh.contains(np.hstack([xy, z]))
-        for dx, dy in ((inset, 0), (-inset, 0), (0, inset), (0, -inset)):
-            if inset > 0:
+        if inset > 0:
+            for dx, dy in ((inset, 0), (-inset, 0), (0, inset), (0, -inset)):
                 ok &= self._mesh.contains(np.hstack([xy + [dx, dy], z]))
         return ok
 

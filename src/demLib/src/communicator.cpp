@@ -20,6 +20,15 @@
 
 namespace dem {
 
+namespace {
+// The known-size exchange's error for a message of another size than announced.
+RuntimeError wrongSize(int from, std::size_t got, std::size_t expected) {
+    return RuntimeError("demLib communicator: rank " + std::to_string(from) + " sent " + std::to_string(got) +
+                        " bytes in the known-size exchange; expected " + std::to_string(expected));
+}
+}  // namespace
+
+
 Communicator::Communicator(std::shared_ptr<const MpiHandle> mpi, int rank, int size)
     : mpi_(std::move(mpi)), rank_(rank), size_(size) {}
 
@@ -204,9 +213,7 @@ Communicator::ExchangeAndFlag processExchangeKnownSizes(const Communicator& c,
         int count = 0;
         MPI_Get_count(&statuses[k + 1], MPI_BYTE, &count);
         if (static_cast<std::size_t>(count) != receiveSizes[from[k]])
-            throw RuntimeError("demLib communicator: rank " + std::to_string(from[k]) + " sent " +
-                               std::to_string(count) + " bytes in the known-size exchange; expected " +
-                               std::to_string(receiveSizes[from[k]]));
+            throw wrongSize(from[k], static_cast<std::size_t>(count), receiveSizes[from[k]]);
     }
     out.anyTrue = any != 0;
     return out;
@@ -287,12 +294,11 @@ Communicator::ExchangeAndFlag Communicator::exchangeKnownSizesAndAnyTrue(const s
     // Thread ranks and the one-process group: the two collectives one after the other.
     out.anyTrue = anyTrue(flag);
     out.received = exchange(sendTo);
-    for (int r = 0; r < size_; ++r)
-        if (r != rank_ && out.received[static_cast<std::size_t>(r)].size() != receiveSizes[static_cast<std::size_t>(r)])
-            throw RuntimeError("demLib communicator: rank " + std::to_string(r) + " sent " +
-                               std::to_string(out.received[static_cast<std::size_t>(r)].size()) +
-                               " bytes in the known-size exchange; expected " +
-                               std::to_string(receiveSizes[static_cast<std::size_t>(r)]));
+    for (int r = 0; r < size_; ++r) {
+        const std::size_t got = out.received[static_cast<std::size_t>(r)].size();
+        if (r != rank_ && got != receiveSizes[static_cast<std::size_t>(r)])
+            throw wrongSize(r, got, receiveSizes[static_cast<std::size_t>(r)]);
+    }
     return out;
 }
 

@@ -12,12 +12,9 @@
 namespace dem {
 
 namespace {
+
 // A ghost update per particle: position, velocity, spin.
 constexpr std::size_t ghostUpdateBytes = 9 * sizeof(double);
-}  // namespace
-
-
-namespace {
 
 void packHistory(ByteWriter& w, const ContactHistory& h) {
     w.put(h.shear);
