@@ -2,11 +2,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 #include <random>
 #include <set>
 
 #include "demLib/particle_reordering.hpp"
 #include "demLib/particle_wall_broad_search.hpp"
+#include "demLib/simulation.hpp"
 
 using dem::Vec3;
 
@@ -99,4 +101,77 @@ TEST(ParticleWallCandidates, ListsStaticWallsWithinReachAndAllMovingWalls) {
     EXPECT_TRUE(listed(1).empty());                   // 4 mm from the floor, 10 mm from the side
     EXPECT_EQ(listed(2), std::vector<int>({0, 1}));   // floor and side wall
     EXPECT_EQ(c.movingWalls(), std::vector<int>({2}));  // the lid moves: checked every step
+}
+
+TEST(WallMotion, TellsWhenItMovesAndWhenThatChanges) {
+    dem::WallMotion m;
+    m.addTranslation(1.0, 2.0, Vec3(0, 0, -0.01));
+    m.addRotation(2.0, 3.0, Vec3::Zero(), Vec3::UnitZ(), 0.5);  // adjacent: moves through t = 2
+    m.addTranslation(4.0, 5.0, Vec3(0.01, 0, 0));
+    EXPECT_FALSE(m.isMovingAt(0.5));
+    EXPECT_TRUE(m.isMovingAt(1.0));
+    EXPECT_TRUE(m.isMovingAt(2.0));
+    EXPECT_FALSE(m.isMovingAt(3.0));
+    EXPECT_FALSE(m.isMovingAt(5.0));
+    EXPECT_EQ(m.nextChangeAfter(0.5), 1.0);
+    EXPECT_EQ(m.nextChangeAfter(1.0), 2.0);
+    EXPECT_EQ(m.nextChangeAfter(2.5), 3.0);
+    EXPECT_EQ(m.nextChangeAfter(3.0), 4.0);
+    EXPECT_EQ(m.nextChangeAfter(4.5), 5.0);
+    EXPECT_EQ(m.nextChangeAfter(5.0), std::numeric_limits<double>::infinity());
+    EXPECT_EQ(dem::WallMotion().nextChangeAfter(0.0), std::numeric_limits<double>::infinity());
+}
+
+TEST(ParticleWallCandidates, WallAtRestBetweenSegmentsIsListedUntilItMoves) {
+    // A die wall that rests, is lowered on [1, 2) s, and rests again: at rest it
+    // is searched near the particles only; under way, for every particle.
+    dem::ParticleStore p;
+    p.add(0, Vec3(0, 0, 0.0012), Vec3::Zero(), 0.001, 2500, 0);  // 0.2 mm from the wall
+    p.add(1, Vec3(0, 0, 0.0050), Vec3::Zero(), 0.001, 2500, 0);  // 4 mm from it
+    dem::WallMotion lowered;
+    lowered.addTranslation(1.0, 2.0, Vec3(0, 0, -0.01));
+    std::vector<dem::Wall> walls{{"die", dem::PlaneWall(Vec3::Zero(), Vec3::UnitZ()), lowered, 0}};
+    dem::ParticleWallCandidates c;
+    auto listed = [&](int i) {
+        return std::vector<int>(c.walls().begin() + c.offsets()[i], c.walls().begin() + c.offsets()[i + 1]);
+    };
+    c.build(p, walls, 0.5, 0.0005);
+    EXPECT_EQ(listed(0), std::vector<int>({0}));
+    EXPECT_TRUE(listed(1).empty());
+    EXPECT_TRUE(c.movingWalls().empty());
+    EXPECT_EQ(c.validUntil(), 1.0);
+    c.build(p, walls, 1.5, 0.0005);
+    EXPECT_TRUE(listed(0).empty());
+    EXPECT_EQ(c.movingWalls(), std::vector<int>({0}));
+    EXPECT_EQ(c.validUntil(), 2.0);
+    c.build(p, walls, 2.5, 0.0005);  // 10 mm lower now: near neither particle
+    EXPECT_TRUE(listed(0).empty());
+    EXPECT_TRUE(c.movingWalls().empty());
+    EXPECT_EQ(c.validUntil(), std::numeric_limits<double>::infinity());
+}
+
+TEST(ParticleWallCandidates, SimulationSearchesAWallFromTheStepItStartsMoving) {
+    // One sphere at rest without gravity never moves far enough to rebuild its
+    // lists; a wall 4 mm away rests until 1 ms and then runs into it at 2 m/s
+    // (contact from 3 ms).  Listed as at rest at the start, the wall is found
+    // only because the lists are built again when it starts moving.
+    const std::vector<dem::Material> mats{{"sand", 5e6, 0.3, 2500.0}};
+    dem::InteractionTable table(1);
+    dem::PairCoefficients coefficients;
+    coefficients.restitution = 0.5;
+    coefficients.friction = 0.5;
+    table.set(mats, 0, 0, coefficients);
+    dem::SimulationSettings s;
+    s.timeStep = 1e-6;
+    s.gravity = Vec3::Zero();
+    dem::WallMotion approach;
+    approach.addTranslation(1e-3, 1.0, Vec3(-2.0, 0, 0));
+    dem::Simulation sim(s, mats, table, {{"pusher", dem::PlaneWall(Vec3(0.005, 0, 0), -Vec3::UnitX()), approach, 0}});
+    sim.insert({{Vec3::Zero(), 0.001}}, 0, Vec3::Zero());
+    sim.step(2900);  // to 2.9 ms
+    EXPECT_EQ(sim.pairList().buildCount(), 1);
+    EXPECT_EQ(sim.particles().velocity[0].x(), 0.0);
+    sim.step(2100);  // to 5 ms
+    // Pushed ahead of the wall: at least the wall's speed (about 1.5x it for e = 0.5).
+    EXPECT_LT(sim.particles().velocity[0].x(), -2.0);
 }

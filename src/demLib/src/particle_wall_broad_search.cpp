@@ -2,16 +2,22 @@
 
 #include "demLib/parallel.hpp"
 
+#include <algorithm>
+#include <limits>
+
 namespace dem {
 
 void ParticleWallCandidates::build(const ParticleStore& particles, const std::vector<Wall>& walls, double time,
                                    double reach) {
     const int n = static_cast<int>(particles.size());
     moving_.clear();
-    std::vector<int> fixed;
+    validUntil_ = std::numeric_limits<double>::infinity();
+    std::vector<int> fixed;  // at rest until validUntil_
     for (int w = 0; w < static_cast<int>(walls.size()); ++w) {
-        if (walls[w].motion.isStatic()) fixed.push_back(w);
-        else moving_.push_back(w);
+        const WallMotion& motion = walls[w].motion;
+        if (motion.isMovingAt(time)) moving_.push_back(w);
+        else fixed.push_back(w);
+        validUntil_ = std::min(validUntil_, motion.nextChangeAfter(time));
     }
     std::vector<int> count(n, 0);
     std::vector<unsigned char> near(static_cast<std::size_t>(n) * fixed.size(), 0);

@@ -657,6 +657,8 @@ double Simulation::redistributeLiquid(double wallReach) {
 
 void Simulation::computeForces(bool forcesReset) {
     if (!forcesReset) resetForces(particles_, settings_.gravity);
+    // A wall starts or stops moving: the walls at rest are listed anew.
+    if (time_ >= wallCandidates_.validUntil()) rebuildWallCandidates();
     last_.contacts = kernel_->compute(particles_, pairs_, wallContacts_, walls_, wallCandidates_, interactions_,
                                       time_, settings_.timeStep);
     // With a decomposition a pair across a slab face breaks on both ranks: the

@@ -1,6 +1,7 @@
 #include "demLib/wall_motion.hpp"
 
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <string>
 
@@ -117,6 +118,20 @@ RigidTransform WallMotion::at(double t) const {
         pose = poseAfter_[i];
     }
     return pose;
+}
+
+bool WallMotion::isMovingAt(double t) const {
+    for (const MotionSegment& segment : segments_)
+        if (segment.tStart <= t && t < segment.tEnd) return true;
+    return false;
+}
+
+double WallMotion::nextChangeAfter(double t) const {
+    for (const MotionSegment& segment : segments_) {
+        if (t < segment.tStart) return segment.tStart;
+        if (t < segment.tEnd) return segment.tEnd;
+    }
+    return std::numeric_limits<double>::infinity();
 }
 
 Vec3 WallMotion::velocityAt(const Vec3& worldPoint, double t) const {

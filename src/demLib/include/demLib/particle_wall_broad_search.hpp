@@ -1,10 +1,13 @@
 #pragma once
 // Particle-wall broad search: which walls each particle may touch before the
-// next neighbour-list rebuild.  A static wall is listed for a particle when the
+// next neighbour-list rebuild.  A wall at rest is listed for a particle when the
 // particle is within its radius + skin of it at build time (it cannot reach a
 // wall farther away before some particle has moved skin/2 and the lists are
-// rebuilt).  Moving walls are not listed: they are checked for every particle
-// every step (their bounding box first).
+// rebuilt).  Walls under way in a motion segment are not listed: they are
+// checked for every particle every step (their bounding box first).  "At rest"
+// includes a wall with a motion between or after its segments (a die wall
+// before it is lowered): the lists hold until validUntil(), the next segment
+// start or end, when the caller must build them again.
 #include <vector>
 
 #include "demLib/particle_store.hpp"
@@ -21,14 +24,17 @@ public:
     // Static walls near particle i: entries [offsets()[i], offsets()[i+1]) of walls().
     const std::vector<int>& offsets() const { return offsets_; }
     const std::vector<int>& walls() const { return walls_; }
-    // Walls with a prescribed motion: checked for every particle.
+    // Walls under way in a motion segment at build time: checked for every particle.
     const std::vector<int>& movingWalls() const { return moving_; }
+    // The first time a wall starts or stops moving after the build.
+    double validUntil() const { return validUntil_; }
     bool empty() const { return offsets_.size() <= 1; }
 
 private:
     std::vector<int> offsets_{0};
     std::vector<int> walls_;
     std::vector<int> moving_;
+    double validUntil_ = 0.0;
 };
 
 }  // namespace dem

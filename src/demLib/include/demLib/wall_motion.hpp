@@ -67,6 +67,11 @@ public:
     bool isActive(double t) const { return t < removalTime_; }
 
     bool isStatic() const { return segments_.empty(); }
+    // Whether a segment is under way at t (tStart <= t < tEnd).
+    bool isMovingAt(double t) const;
+    // The first segment start or end after t (infinity when none): until then
+    // the wall keeps moving, or keeps resting, as at t.
+    double nextChangeAfter(double t) const;
     const std::vector<MotionSegment>& segments() const { return segments_; }
 
     // Pose at time t: x_world = R x_ref + c.
