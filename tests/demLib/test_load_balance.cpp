@@ -19,6 +19,7 @@
 #include "demLib/error.hpp"
 #include "demLib/ghost_exchange.hpp"
 #include "demLib/particle_store.hpp"
+#include "demLib/simulation.hpp"
 
 namespace {
 
@@ -419,6 +420,73 @@ TEST(Rebalance, WeightsDecideTheLoad) {
         for (std::size_t i = 0; i < p.size(); ++i) load += p.position[i].x() < 0.5 ? 4.0 : 1.0;
         EXPECT_LE(c.max(load), 1.01 * 5000.0 + 3 * 4.0);
         EXPECT_THROW(exchange.rebalanceIfNeeded(p, {1.0}), dem::InputError);
+    });
+}
+
+// --- The Simulation's re-cut: by particles or by work ---
+
+// A block of 10 x 10 x 10 touching spheres (a simple cubic packing: up to 6
+// listed neighbours each, work about 3.7) at x < 0.02 m and 1000 spheres far
+// apart (no pairs, work 1) on a line out to x = 1 m, on 2 thread ranks that
+// start with equal slabs.  The first list build balances counts (no pairs are
+// known yet): one rank ends up with the block, the other with the line.  An
+// insertion makes the lists build again: weighted by work the slabs are
+// re-cut through the block, by particles they stay.
+void blockAndLine(dem::LoadBalanceWeight weight, const Communicator& c, std::size_t& recuts,
+                  dem::GhostExchange::RebalanceReport& lastRecut, double& ownedMaxOverMean) {
+    const double r = 5e-4;
+    const std::vector<dem::Material> mats{{"sand", 5e6, 0.3, 2500.0}};
+    dem::InteractionTable table(1);
+    dem::PairCoefficients coefficients;
+    coefficients.restitution = 0.5;
+    coefficients.friction = 0.5;
+    table.set(mats, 0, 0, coefficients);
+    dem::SimulationSettings s;
+    s.timeStep = 1e-6;
+    s.gravity = Vec3::Zero();
+    s.loadBalanceWeight = weight;
+    dem::Simulation sim(s, mats, table, {});
+    sim.setDecomposition(std::make_shared<dem::GhostExchange>(c, SlabDecomposition::uniform(2, 0, 0.0, 1.0),
+                                                              s.loadBalanceThreshold));
+    std::vector<dem::InsertedParticle> spheres;
+    const double spacing = 2.0 * r * (1.0 - 1e-4);
+    for (int i = 0; i < 10; ++i)
+        for (int j = 0; j < 10; ++j)
+            for (int k = 0; k < 10; ++k)  // (staggered in x by up to 1e-5 m: a cut may split a layer)
+                spheres.push_back({Vec3(r + i * spacing + (10 * j + k) * 1e-7, j * spacing, k * spacing), r});
+    for (int i = 0; i < 1000; ++i) spheres.push_back({Vec3(0.03 + i * 9e-4, 0.05 + (i % 2) * 2e-3, 0.0), r});
+    sim.insert(spheres, 0, Vec3::Zero());
+    sim.step(1);
+    EXPECT_EQ(sim.decomposition()->recutCount(), 1u);
+    sim.insert({{Vec3(0.5, -0.05, 0.0), r}}, 0, Vec3::Zero());
+    sim.step(1);
+    recuts = sim.decomposition()->recutCount();
+    lastRecut = sim.decomposition()->lastRecut();
+    const double owned = static_cast<double>(sim.ownedCount());
+    ownedMaxOverMean = c.max(owned) / (c.sum(owned) / c.size());
+    EXPECT_EQ(c.sum(static_cast<std::int64_t>(sim.ownedCount())), 2001);
+}
+
+TEST(Rebalance, SimulationBalancesWorkWhenAsked) {
+    Communicator::runThreadGroup(2, [](const Communicator& c) {
+        std::size_t recuts = 0;
+        dem::GhostExchange::RebalanceReport report;
+        double owned = 0.0;
+        blockAndLine(dem::LoadBalanceWeight::Work, c, recuts, report, owned);
+        EXPECT_EQ(recuts, 2u);
+        EXPECT_TRUE(report.weighted);
+        // Work before: the block's rank about 1000 x 3.7 against 1001 x 1.
+        EXPECT_GT(report.imbalance, 1.4);
+        EXPECT_LT(report.imbalance, 1.7);
+        EXPECT_LE(report.loadImbalanceAfter, 1.03);
+        ASSERT_EQ(report.cuts.size(), 1u);
+        EXPECT_LT(report.cuts[0], 0.02) << "cut through the block";
+        EXPECT_GT(owned, 1.2) << "equal work is not equal counts here";
+
+        blockAndLine(dem::LoadBalanceWeight::Particles, c, recuts, report, owned);
+        EXPECT_EQ(recuts, 1u) << "equal counts: no second re-cut";
+        EXPECT_FALSE(report.weighted);
+        EXPECT_LE(owned, 1.01);
     });
 }
 

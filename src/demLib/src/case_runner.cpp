@@ -113,7 +113,8 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
         for (int d = 1; d < 3; ++d)
             if (high[d] - low[d] > high[axis] - low[axis]) axis = d;
         simulation_->setDecomposition(std::make_shared<GhostExchange>(
-            comm, SlabDecomposition::uniform(comm.size(), axis, low[axis], high[axis])));
+            comm, SlabDecomposition::uniform(comm.size(), axis, low[axis], high[axis]),
+            setup_.settings.loadBalanceThreshold));
     }
     wetted_ = !(setup_.wettingTime > 0.0);
     const fs::path out = outputDirectory();
@@ -745,8 +746,12 @@ void CaseRunner::logRecuts() {
     const GhostExchange::RebalanceReport& r = d->lastRecut();
     log_ << "DEM slabs re-cut at t = " << simulation_->time() << " s (" << d->recutCount() - recutsLogged_
          << " since the last line): owned particles max " << r.maxOwned << " / mean " << r.meanOwned
-         << " = " << r.imbalance << " before, max/mean " << r.imbalanceAfter << " after; cuts along "
-         << "xyz"[d->slabs().axis()] << " now at";
+         << " = " << static_cast<double>(r.maxOwned) / r.meanOwned << " before, max/mean "
+         << r.imbalanceAfter << " after";
+    if (r.weighted)
+        log_ << "; work (1 + listed pairs + wall contacts per particle) max/mean " << r.imbalance << " before, "
+             << r.loadImbalanceAfter << " after";
+    log_ << "; cuts along " << "xyz"[d->slabs().axis()] << " now at";
     for (double c : r.cuts) log_ << " " << c;
     log_ << " m" << std::endl;
     recutsLogged_ = d->recutCount();

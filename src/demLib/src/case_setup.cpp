@@ -424,6 +424,14 @@ CaseSetup readCaseSetup(const Dictionary& root, const std::string& caseDir) {
     if (sim.has("impactVelocity")) s.impactVelocity = sim.getPositive("impactVelocity");
     if (sim.has("maxCapillaryClusterFraction"))
         s.maxCapillaryClusterFraction = sim.getInRange("maxCapillaryClusterFraction", 1e-3, 1.0);
+    if (sim.has("loadBalance")) {
+        const Dictionary& balance = sim.subDict("loadBalance");
+        if (balance.has("weight"))
+            s.loadBalanceWeight = balance.getChoice("weight", {"particles", "work"}) == "work"
+                                      ? LoadBalanceWeight::Work
+                                      : LoadBalanceWeight::Particles;
+        if (balance.has("threshold")) s.loadBalanceThreshold = balance.getInRange("threshold", 1.0, 1e3);
+    }
     if (sim.has("domain")) {
         const Dictionary& box = sim.subDict("domain");
         AxisAlignedBox b{box.get<Vec3>("min"), box.get<Vec3>("max")};

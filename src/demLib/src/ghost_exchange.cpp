@@ -115,7 +115,21 @@ GhostExchange::RebalanceReport GhostExchange::rebalanceIfNeeded(const ParticleSt
         for (std::size_t i = 0; i < owned; ++i) coordinates[i] = p.position[i][axis];
         setSlabs(SlabDecomposition::balanced(communicator_, axis, coordinates, weights));
         ++recuts_;
+        if (!weights.empty()) {
+            // The load each rank will hold: the weights by their new owner.
+            std::vector<double> load(ranks, 0.0);
+            const int me = rank();
+            for (std::size_t i = 0; i < owned; ++i) load[slabs_.ownerOf(p.position[i], me)] += weights[i];
+            load = sumOverRanksInRankOrder(communicator_, load);
+            double largest = 0.0, total = 0.0;
+            for (double l : load) {
+                largest = std::max(largest, l);
+                total += l;
+            }
+            report.loadImbalanceAfter = total > 0.0 ? largest / (total / ranks) : 1.0;
+        }
     }
+    report.weighted = !weights.empty();
     report.recut = recut;
     report.cuts = slabs_.interiorCuts();
     lastRebalance_ = report;

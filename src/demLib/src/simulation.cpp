@@ -476,8 +476,13 @@ void Simulation::updatePairList() {
         // History to the id-keyed stash, ghosts away, the slabs re-cut when
         // the owned counts drifted apart (the powder moved), particles to
         // their owners.
+        // The work is read from the lists before dropGhosts empties them; the
+        // owned particles keep their order.
+        const bool byWork =
+            settings_.loadBalanceWeight == LoadBalanceWeight::Work && decomposition_->balancingEnabled();
+        const std::vector<double> work = byWork ? ownedWork() : std::vector<double>();
         decomposition_->dropGhosts(particles_, pairs_, wallContacts_);
-        const bool recut = decomposition_->rebalanceIfNeeded(particles_).recut;
+        const bool recut = decomposition_->rebalanceIfNeeded(particles_, work).recut;
         decomposition_->migrate(particles_);
         if (recut) decomposition_->noteBalanceAfterMigration(particles_);
     }
@@ -546,6 +551,27 @@ void Simulation::updatePairList() {
                                   : std::numeric_limits<double>::infinity();
     }
     rebuildWallCandidates();
+}
+
+std::vector<double> Simulation::ownedWork() const {
+    const std::size_t owned = ownedCount();
+    std::vector<double> work(owned, 1.0);
+    const auto& offsets = pairs_.offsets();
+    const auto& neighbors = pairs_.neighbors();
+    const std::size_t rows = std::min(owned, offsets.size() - 1);
+    for (std::size_t i = 0; i < rows; ++i)
+        for (int k = offsets[i]; k < offsets[i + 1]; ++k) {
+            const std::size_t j = static_cast<std::size_t>(neighbors[k]);
+            if (j < owned) {
+                work[i] += 0.5;
+                work[j] += 0.5;
+            } else {
+                work[i] += 1.0;
+            }
+        }
+    for (const WallContactRecord& r : wallContacts_.records())
+        if (static_cast<std::size_t>(r.particle) < owned) work[r.particle] += 1.0;
+    return work;
 }
 
 void Simulation::rebuildWallCandidates() {

@@ -112,6 +112,10 @@ public:
         // After a re-cut and the migration that follows it: max/mean owned
         // (noteBalanceAfterMigration; 0 until then).
         double imbalanceAfter = 0.0;
+        // With weights: whether they were given, and after a re-cut max/mean
+        // of the summed weights under the new cuts (0 otherwise).
+        bool weighted = false;
+        double loadImbalanceAfter = 0.0;
     };
     // A threshold t >= 1: re-cut when max/mean load > t.  0 or +infinity
     // disables balancing (rebalanceIfNeeded then does no collective; all ranks

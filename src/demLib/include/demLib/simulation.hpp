@@ -23,6 +23,12 @@
 
 namespace dem {
 
+// What the slabs of a domain decomposition balance when they are re-cut.
+enum class LoadBalanceWeight {
+    Particles,  // each rank's owned particles
+    Work        // their work: per particle 1 + its listed pairs + its wall contacts
+};
+
 struct SimulationSettings {
     double timeStep = 1e-5;
     Vec3 gravity = Vec3(0.0, 0.0, -9.81);
@@ -59,6 +65,14 @@ struct SimulationSettings {
     std::size_t spatialSortMinParticles = 4096;
     // Particles whose centre leaves this box are removed and counted as lost.
     std::optional<AxisAlignedBox> domain;
+    // With a domain decomposition: what a re-cut of the slabs balances, and the
+    // max/mean of that load over the ranks beyond which the slabs are re-cut
+    // (at a list build; GhostExchange::rebalanceIfNeeded).  Work counts, per
+    // owned particle, 1 plus its pairs listed at the last build (a pair of two
+    // owned particles half at each, a pair with a ghost whole, as this rank
+    // computes it) plus its wall contacts: the pair walk is most of a step.
+    LoadBalanceWeight loadBalanceWeight = LoadBalanceWeight::Particles;
+    double loadBalanceThreshold = GhostExchange::defaultRebalanceThreshold;
     // Name of the input the settings came from, for error messages.
     std::string source = "demLib";
 };
@@ -204,6 +218,8 @@ private:
     // the drift has just tested every particle and found none (no pass here).
     void removeLostParticles(bool knownNoneLost = false);
     void updatePairList();
+    // Per owned particle, its work at the last list build (LoadBalanceWeight::Work).
+    std::vector<double> ownedWork() const;
     void rebuildWallCandidates();
     double redistributeLiquid(double wallReach);  // returns λ, the liquid per unit weight
     // Walls within `reach` of each particle's surface at the current positions:
