@@ -49,7 +49,8 @@ map.png (top view, with the cavity's outline), sectionXZ.png/.csv, sectionYZ.png
 fillDensity.vtk (STRUCTURED_POINTS; open in ParaView), regions.csv; and adds <N>.mean,
 .max, .min, .maxMinusMin, .coefficientOfVariation, .time, .cell, ... and the regions'
 <N>.region.<NAME>.mass/.bulkDensity to CASE/postProcessing/results.json (the keys that
-other tools wrote are kept).  Units: SI (m, kg, kg/m3, s)."""
+other tools wrote are kept); with a pre-compaction stamp (dieCase.json steps/stamp) also
+<N>.stamp.peakForce, .pressure and .dieWallShare from dem/summary.csv's wall forces.  Units: SI (m, kg, kg/m3, s)."""
 import csv
 import json
 import os
@@ -60,7 +61,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _common import argument_parser, finite, frame_at, out_dir, positive, positive_int, run_main  # noqa: E402
-from diefillpost import closedmesh, output, plots, results, series  # noqa: E402
+from diefillpost import closedmesh, output, plots, results, series, summary  # noqa: E402
 
 CHUNK = 8000          # particles per chunk of quadrature points (8000 x 128 points)
 
@@ -217,6 +218,31 @@ def write_rows(path, header, rows):
                         for v in r])
 
 
+def stamp_figures(case, p, stamp, opening_area):
+    """The pre-compaction stamp's force from dem/summary.csv (the powder's force on the walls):
+    its peak, its mean while held at depth as a pressure over the opening, and the share of it
+    that the die's side walls carry by friction (the rest reaches the floors)."""
+    columns = summary.read(case)
+    t = columns["time"]
+    force = columns["wallForce_stamp_z"]
+    held = (t >= stamp["pressed_s"]) & (t <= stamp["released_s"])
+    if not np.any(held) or not np.any(force > 0):
+        raise ValueError(f"'{case}/dem/summary.csv': the stamp never pressed on the powder (no force on it while "
+                         f"held at {stamp['depth_m'] * 1e3:g} mm, {stamp['pressed_s']:g}-{stamp['released_s']:g} s): "
+                         "expected a run to past the stamp's hold")
+    mean = float(np.mean(force[held]))
+    walls = float(-np.mean(columns["wallForce_dieWalls_z"][held]))
+    when = f"held at {stamp['depth_m'] * 1e3:g} mm below the table, {stamp['pressed_s']:.4g}-{stamp['released_s']:.4g} s"
+    return {
+        f"{p}.stamp.peakForce": {"value": float(np.max(force)), "unit": "N",
+                                 "description": "largest force of the powder on the pre-compaction stamp"},
+        f"{p}.stamp.pressure": {"value": mean / opening_area, "unit": "Pa",
+                                "description": f"mean force on the stamp / opening area, {when}"},
+        f"{p}.stamp.dieWallShare": {"value": walls / mean if mean > 0 else None, "unit": "-",
+                                    "description": f"the die side walls' share of the stamp force (friction), {when}"},
+    }
+
+
 def die_case(case):
     """The defaults that a case written by writeDieCase.py gives (constant/dieCase.json):
     {filled: time, regionGrid: [nx, ny], regions: {name: [x0, y0, x1, y1]}}; {} without
@@ -235,6 +261,10 @@ def die_case(case):
             if len(out["regionGrid"]) != 2 or min(out["regionGrid"]) < 1:
                 raise ValueError("regionGrid")
         out["regions"] = {str(k): [float(x) for x in v] for k, v in (d.get("regions_m") or {}).items()}
+        out["stamp"] = (d.get("steps") or {}).get("stamp")
+        if out["stamp"] is not None:
+            out["stamp"] = {k: float(out["stamp"][k]) for k in ("depth_m", "pressed_s", "released_s")}
+            out["openingArea"] = float(d["openingArea_m2"])
         if any(len(v) != 4 for v in out["regions"].values()):
             raise ValueError("regions_m")
     except (ValueError, TypeError, AttributeError) as e:
@@ -460,6 +490,8 @@ def main():
                                           "description": f"powder in the cavity over {box}"}
         res[f"{p}.region.{name}.bulkDensity"] = {"value": rho, "unit": "kg/m3",
                                                  "description": f"mass / cavity volume ({vol:.6g} m3) over {box}"}
+    if die.get("stamp"):
+        res.update(stamp_figures(a.case, p, die["stamp"], die["openingArea"]))
     results.update(a.case, res)
     print(f"fillDensity: {when}, {mass_now * 1e3:.4g} g in the cavity ({mesh.volume * 1e6:.4g} cm3, overall "
           f"{mass_now / mesh.volume:.1f} kg/m3); columns of {h * 1e3:.3g} mm: mean {stats['mean']:.1f} kg/m3, "

@@ -9,7 +9,8 @@ powder, the steps of the rig) and writes, in DIR:
                         (the table with the opening cut out), dieWalls.stl (lowered with the
                         table), dieFloors.stl (the punches: they stay), opening.stl, airWalls.stl
                         (table + walls + floors: the air mesh's wall), shoe.stl (a box or STL shoe's
-                        wall), shoeInside.stl (an STL shoe: its inside, the insertion region)
+                        wall), shoeInside.stl (an STL shoe: its inside, the insertion region),
+                        stamp.stl (with steps/stamp: the pre-compaction stamp's face)
   constant/demProperties.orig  the DEM: walls from those STL files, the shoe's motion, insertion
                         in the shoe, the timeline, output regions (the cavity, the region grid)
   system/blockMeshDict, snappyHexMeshDict, meshQualityDict, topoSetDict, createPatchDict
@@ -43,6 +44,9 @@ AIR_STEP = 1e-3              # s, the air's time step (system/controlDict)
 DEM_STEP_PER_GRAIN = 6.25e-7  # s per unit of coarse grain: the paper case's rule (validation/README.md)
 OPENING_SPEED = 0.05         # m/s, the die wall and table lowered (the quick paper case's)
 SETTLE = 0.3                 # s after the last shoe motion before the opening, and after the opening
+STAMP_SPEED = 0.01           # m/s, the pre-compaction stamp's default pressing speed
+STAMP_APPROACH_SPEED = 0.2   # m/s, the stamp down to the table and back up
+STAMP_HOLD = 0.2             # s, the stamp held at its depth (default)
 
 
 class DictError(ValueError):
@@ -288,8 +292,25 @@ def write_case(case, path, rel, a):
     air = steps.switch("air", True)
     aeration = steps.switch("aeration", False)
     lower = steps.switch("lowerDieWall", True)
-    if steps.switch("stamp", False):
-        steps.fail("stamp", "no: a pre-compaction stamp is not supported yet (docs/own-die.md)")
+    stamp = None
+    if isinstance(steps.d.get("stamp"), dict):
+        press = steps.sub("stamp")
+        press.check_keys(["depth", "speed", "hold"])
+        stamp = {"depth": press.number("depth", low=0.0, low_open=True) * scale,
+                 "speed": press.number("speed", STAMP_SPEED, low=0.0, low_open=True, high=STAMP_APPROACH_SPEED),
+                 "hold": press.number("hold", STAMP_HOLD, low=0.0)}
+        if stamp["depth"] >= 0.5 * depth:
+            press.fail("depth", f"a depth below the table (in {unit}) less than half the cavity's "
+                                f"{depth / scale:.4g} {unit}", stamp["depth"] / scale)
+    elif steps.switch("stamp", False):
+        steps.fail("stamp", "no, or stamp { depth D; speed V; hold T; }: how far below the table the stamp "
+                            f"presses (D, in {unit}), at V m/s (default {STAMP_SPEED:g}), held T s (default "
+                            f"{STAMP_HOLD:g})", "yes")
+    end_xy = path_xy[-1]
+    if stamp and np.all(end_xy - half < ohi[:2]) and np.all(end_xy + half > olo[:2]):
+        steps.fail("stamp", "no stamp, or a shoe path that ends beside the opening: the stamp comes down over "
+                            f"the opening, where the shoe stops (its centre at x {end_xy[0] / scale:.4g}, "
+                            f"y {end_xy[1] / scale:.4g} {unit})", "a stamp")
     if aeration and not air:
         steps.fail("aeration", "no when air is no (aeration blows air through the powder)")
     results = root.sub("results", required=False)
@@ -319,6 +340,16 @@ def write_case(case, path, rel, a):
     fill_end = 0.5 * segments[0][0] if segments[0][0] > 0 else 0.0
     pass_end = segments[-1][1]
     open_start = pass_end + SETTLE
+    if stamp:
+        # The stamp waits above the shoe, comes down to the table, presses to its depth, is
+        # held there and goes back up; the die counts as filled SETTLE after that.
+        stamp["park"] = 1.2 * height
+        stamp["down"] = open_start
+        stamp["onTable"] = stamp["down"] + stamp["park"] / STAMP_APPROACH_SPEED
+        stamp["pressed"] = stamp["onTable"] + stamp["depth"] / stamp["speed"]
+        stamp["released"] = stamp["pressed"] + stamp["hold"]
+        stamp["up"] = stamp["released"] + (stamp["park"] + stamp["depth"]) / STAMP_APPROACH_SPEED
+        open_start = stamp["up"] + SETTLE
     open_end = open_start + 1.2 * depth / OPENING_SPEED
     end_time = (open_end if lower else open_start) + SETTLE
     wave = max(0.02, min(0.2, 0.5 * max(segments[0][0], 0.1) / 3))
@@ -338,7 +369,11 @@ def write_case(case, path, rel, a):
                        "filled": open_start, "opening": open_start if lower else None,
                        "openingEnds": open_end if lower else None, "end": end_time},
         "powder": {"mass_kg": mass, "coarseGrain": grain, "waterContent": water, "seed": int(seed)},
-        "steps": {"air": air, "aeration": aeration, "lowerDieWall": lower},
+        "steps": {"air": air, "aeration": aeration, "lowerDieWall": lower,
+                  "stamp": None if not stamp else {
+                      "depth_m": stamp["depth"], "speed_m_s": stamp["speed"], "hold_s": stamp["hold"],
+                      "parkedAt_m": stamp["park"], "comesDown_s": stamp["down"], "onTable_s": stamp["onTable"],
+                      "pressed_s": stamp["pressed"], "released_s": stamp["released"], "up_s": stamp["up"]}},
         "timeStep_s": step, "regionGrid": [int(grid[0]), int(grid[1])],
         "regions_m": {k: list(map(float, v)) for k, v in named.items()},
     }
@@ -356,6 +391,11 @@ def write_case(case, path, rel, a):
     write_stl(os.path.join(tri_dir, "dieFloors.stl"), "dieFloors", cavity.triangles(cavity.is_floor))
     write_stl(os.path.join(tri_dir, "airWalls.stl"), "walls",
               np.concatenate([table, cavity.triangles(cavity.is_wall), cavity.triangles(cavity.is_floor)]))
+    if stamp:
+        # The stamp's face: the opening itself, waiting above the shoe (its reference position)
+        face = cavity.triangles(cavity.is_opening).copy()
+        face[:, :, 2] += stamp["park"]
+        write_stl(os.path.join(tri_dir, "stamp.stl"), "stamp", face)
     shoe_wall_triangles, shoe_inside = shoe.wall_triangles(), shoe.region_triangles()
     if shoe_wall_triangles is not None:
         write_stl(os.path.join(tri_dir, "shoe.stl"), "shoe", shoe_wall_triangles)
@@ -409,10 +449,24 @@ def write_case(case, path, rel, a):
     for name, v in named.items():
         regions.append(f"        {name} {{ type box; min {fmt([v[0], v[1], lo[2] - 1e-6])}; max {fmt([v[2], v[3], 0.0])}; }}")
     regions_text = "\n".join(regions)
+    stamp_wall = ""
+    if stamp:
+        a_, v_ = STAMP_APPROACH_SPEED, stamp["speed"]
+        stamp_wall = (
+            "    // The pre-compaction stamp: the opening's shape, parked above the shoe\n"
+            "    stamp\n    {\n        type stl; file \"constant/triSurface/stamp.stl\"; material steel;\n"
+            "        motion\n        {\n"
+            f"            down  {{ type translate; start {stamp['down']:.9g}; end {stamp['onTable']:.9g}; "
+            f"velocity (0 0 {-a_:g}); }}\n"
+            f"            press {{ type translate; start {stamp['onTable']:.9g}; end {stamp['pressed']:.9g}; "
+            f"velocity (0 0 {-v_:g}); }}\n"
+            f"            up    {{ type translate; start {stamp['released']:.9g}; end {stamp['up']:.9g}; "
+            f"velocity (0 0 {a_:g}); }}\n"
+            "        }\n    }\n")
     dem = f"""FoamFile {{ version 2.0; format ascii; class dictionary; object demProperties; }}
 // Written by writeDieCase.py from {rel}; edit that file and run ./Allrun again.
 // Timeline: shoe filled by {fill_end:.4g} s; shoe moves {segments[0][0]:.4g}-{pass_end:.4g} s;
-// {"die wall and table lowered " + f"{open_start:.4g}-{open_end:.4g} s; " if lower else ""}end {end_time:.4g} s.
+// {"stamp down " + f"{stamp['down']:.4g} s, pressed {stamp['depth'] * 1e3:.4g} mm {stamp['onTable']:.4g}-{stamp['pressed']:.4g} s, up by {stamp['up']:.4g} s; " if stamp else ""}{"die wall and table lowered " + f"{open_start:.4g}-{open_end:.4g} s; " if lower else ""}end {end_time:.4g} s.
 
 simulation
 {{
@@ -436,7 +490,7 @@ walls
     table     {{ type stl; file "constant/triSurface/table.stl"; material steel; {opening} }}
     dieWalls  {{ type stl; file "constant/triSurface/dieWalls.stl"; material steel; {opening} }}
     dieFloors {{ type stl; file "constant/triSurface/dieFloors.stl"; material steel; }}
-    shoe
+{stamp_wall}    shoe
     {{
         {shoe_wall}
         motion

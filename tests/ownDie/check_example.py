@@ -65,6 +65,30 @@ def main(name, case):
               f"({near * 1e3:.2f} g vs {far * 1e3:.2f} g)", near > far)
         check("near + far halves = the cavity (regions from the dieDict)",
               abs(float(at["mass_nearHalf"]) + float(at["mass_farHalf"]) - cavity) <= 0.01 * cavity)
+        stamp = info["steps"].get("stamp")
+        check("the ring example has a pre-compaction stamp", bool(stamp))
+        if stamp:
+            # Held at depth, the stamp's force goes through the powder to the floors and, by
+            # friction, to the die wall: the forces on the walls balance (plus the powder's weight).
+            held = [r for r in rows if stamp["pressed_s"] <= float(r["time"]) <= stamp["released_s"]]
+            f = lambda r, w: float(r[f"wallForce_{w}_z"])
+            pressed = [f(r, "stamp") for r in held]
+            weight = 9.81 * cavity
+            residual = max(abs(f(r, "stamp") + f(r, "dieFloors") + f(r, "dieWalls") + weight) for r in held)
+            before = next(float(r["mass_cavity"]) for r in reversed(rows) if float(r["time"]) <= stamp["comesDown_s"])
+            check(f"stamp held {stamp['depth_m'] * 1e3:g} mm in: pressed by the powder ({min(pressed):.2f}-"
+                  f"{max(pressed):.2f} N), balanced by floors + die wall - the powder's weight ({weight:.3f} N) "
+                  f"to {residual:.3f} N (1 % allowed)",
+                  held and min(pressed) > 10 * weight and residual <= 0.01 * sum(pressed) / len(pressed))
+            walls = -sum(f(r, "dieWalls") for r in held) / sum(pressed)
+            check(f"stamp: the die wall carries part of it by friction ({walls:.2f}), the floors the rest",
+                  0.05 < walls < 0.95)
+            check(f"stamp: no powder pressed out of the cavity ({before * 1e3:.3f} g before, {cavity * 1e3:.3f} g "
+                  "after)", abs(cavity - before) <= 0.005 * before)
+            pressure = number("stamp.pressure")
+            check(f"results.json: the stamp's pressure {pressure} Pa = its mean force while held / the opening area",
+                  isinstance(pressure, float) and abs(pressure * info["openingArea_m2"] - sum(pressed) / len(pressed))
+                  <= 1e-6 * sum(pressed) / len(pressed))
     else:
         v_shallow, v_deep = 24e-3 * 24e-3 * 10e-3, 8e-3 * 24e-3 * 20e-3
         shallow = float(at["mass_shallow"]) / v_shallow

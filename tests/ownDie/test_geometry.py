@@ -4,6 +4,7 @@ tools/writeDieCase.py) against numbers known by construction.  One line per chec
 import json
 import math
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -13,7 +14,7 @@ import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(ROOT, "tools"))
-from diefillpost.cavity import Cavity, CavityError, table_triangles, write_stl  # noqa: E402
+from diefillpost.cavity import Cavity, CavityError, read_stl, table_triangles, write_stl  # noqa: E402
 from diefillpost.shoe import Shoe, ShoeError  # noqa: E402
 import writeDieStl  # noqa: E402
 
@@ -250,14 +251,41 @@ results { regionGrid (2 2); regions { near (-20 -20 0 20); } }
           and "source boxToFace; boxes (" in topo and summary["shoe"]["type"] == "stl"
           and abs(summary["shoe"]["footprintArea_m2"] - polygon_area(8, 0.025)) < 1e-12, out.strip()[-200:])
 
+    # A pre-compaction stamp: the opening's shape parked above the shoe, down to the table,
+    # pressed 4 mm in at 0.02 m/s, held 0.1 s, back up; the opening after it
+    stamped = good.replace("lowerDieWall yes;", "lowerDieWall yes; stamp { depth 4; speed 0.02; hold 0.1; }")
+    write_dict(stamped)
+    rc, out = run([os.path.join(ROOT, "tools", "writeDieCase.py"), "-case", case], tmp)
+    summary = json.load(open(os.path.join(case, "constant", "dieCase.json")))
+    dem = open(os.path.join(case, "constant", "demProperties.orig")).read()
+    face = read_stl(os.path.join(case, "constant", "triSurface", "stamp.stl"))
+    st, tl = summary["steps"]["stamp"], summary["timeline_s"]
+    check("stamp: its face is the opening (area) at 1.2 x the shoe's height (36 mm)",
+          rc == 0 and abs(table_area(face) - summary["openingArea_m2"]) < 1e-12
+          and np.allclose(face[:, :, 2], 0.036, atol=1e-15), out.strip()[-200:])
+    segments = [tuple(float(v) for v in m) for m in re.findall(
+        r"(?:down|press|up) +\{ type translate; start ([-\d.e]+); end ([-\d.e]+); velocity \(0 0 ([-\d.e]+)\); \}", dem)]
+    height = np.cumsum([(e - s) * v for s, e, v in segments]) + 0.036 if len(segments) == 3 else []
+    check("stamp: down to the table, 4 mm into the die at 0.02 m/s, back up to where it waited",
+          len(segments) == 3 and np.allclose(height, [0.0, -0.004, 0.036], atol=1e-9)
+          and abs(segments[1][2] + 0.02) < 1e-15, str(segments))
+    check("stamp: after the shoe stops and the powder settles (0.3 s), held 0.1 s; the opening 0.3 s after it is up",
+          abs(st["comesDown_s"] - (tl["shoeStops"] + 0.3)) < 1e-12 and abs(st["released_s"] - st["pressed_s"] - 0.1) < 1e-12
+          and abs(tl["opening"] - (st["up_s"] + 0.3)) < 1e-12 and tl["filled"] == tl["opening"]
+          and abs(segments[2][0] - st["released_s"]) < 1e-9, str(st))
+
     bad = [
+        ("a stamp without its depth", good.replace("lowerDieWall yes;", "lowerDieWall yes; stamp yes;"), "steps/stamp"),
+        ("a stamp deeper than half the cavity", stamped.replace("depth 4;", "depth 10;"), "steps/stamp/depth"),
+        ("a stamp with an unknown keyword", stamped.replace("hold 0.1;", "hold 0.1; force 5;"), "steps/stamp/force"),
+        ("a stamp where the shoe stops over the opening",
+         stamped.replace("distance 100; passes 2;", "distance 50; passes 1;"), "steps/stamp"),
         ("a misspelt keyword", good.replace("passes 2;", "pases 2;"), "motion/pases"),
         ("an unknown shoe type", good.replace("type box;", "type sphere;"), "shoe/type"),
         ("a negative mass", good.replace("mass 0.04;", "mass -1;"), "powder/mass"),
         ("more powder than the shoe holds", good.replace("mass 0.04;", "mass 4;"), "powder/mass"),
         ("a shoe path that never crosses the die", good.replace("start (-50 0);", "start (-50 60);"), "motion"),
         ("a shoe that starts over the opening", good.replace("start (-50 0);", "start (0 0);"), "shoe/start"),
-        ("a stamp (not supported yet)", good.replace("lowerDieWall yes;", "lowerDieWall yes; stamp yes;"), "steps/stamp"),
         ("a wrong unit", good.replace("unit mm;", "unit m;"), "across"),
         ("an STL that does not exist", good.replace("ring.stl", "rign.stl"), "die/cavity"),
         ("a shoe STL that does not exist", stl_shoe.replace("octagonShoe.stl", "octagon.stl"), "shoe/file"),
