@@ -9,6 +9,7 @@
 #include "demLib/particle_reordering.hpp"
 #include "demLib/particle_wall_broad_search.hpp"
 #include "demLib/simulation.hpp"
+#include "sand_without_gravity.hpp"
 
 using dem::Vec3;
 
@@ -155,18 +156,9 @@ TEST(ParticleWallCandidates, SimulationSearchesAWallFromTheStepItStartsMoving) {
     // lists; a wall 4 mm away rests until 1 ms and then runs into it at 2 m/s
     // (contact from 3 ms).  Listed as at rest at the start, the wall is found
     // only because the lists are built again when it starts moving.
-    const std::vector<dem::Material> mats{{"sand", 5e6, 0.3, 2500.0}};
-    dem::InteractionTable table(1);
-    dem::PairCoefficients coefficients;
-    coefficients.restitution = 0.5;
-    coefficients.friction = 0.5;
-    table.set(mats, 0, 0, coefficients);
-    dem::SimulationSettings s;
-    s.timeStep = 1e-6;
-    s.gravity = Vec3::Zero();
     dem::WallMotion approach;
     approach.addTranslation(1e-3, 1.0, Vec3(-2.0, 0, 0));
-    dem::Simulation sim(s, mats, table, {{"pusher", dem::PlaneWall(Vec3(0.005, 0, 0), -Vec3::UnitX()), approach, 0}});
+    dem::Simulation sim = sandWithoutGravity({{"pusher", dem::PlaneWall(Vec3(0.005, 0, 0), -Vec3::UnitX()), approach, 0}});
     sim.insert({{Vec3::Zero(), 0.001}}, 0, Vec3::Zero());
     sim.step(2900);  // to 2.9 ms
     EXPECT_EQ(sim.pairList().buildCount(), 1);

@@ -20,6 +20,7 @@
 #include "demLib/ghost_exchange.hpp"
 #include "demLib/particle_store.hpp"
 #include "demLib/simulation.hpp"
+#include "sand_without_gravity.hpp"
 
 namespace {
 
@@ -435,17 +436,9 @@ TEST(Rebalance, WeightsDecideTheLoad) {
 void blockAndLine(dem::LoadBalanceWeight weight, const Communicator& c, std::size_t& recuts,
                   dem::GhostExchange::RebalanceReport& lastRecut, double& ownedMaxOverMean) {
     const double r = 5e-4;
-    const std::vector<dem::Material> mats{{"sand", 5e6, 0.3, 2500.0}};
-    dem::InteractionTable table(1);
-    dem::PairCoefficients coefficients;
-    coefficients.restitution = 0.5;
-    coefficients.friction = 0.5;
-    table.set(mats, 0, 0, coefficients);
     dem::SimulationSettings s;
-    s.timeStep = 1e-6;
-    s.gravity = Vec3::Zero();
     s.loadBalanceWeight = weight;
-    dem::Simulation sim(s, mats, table, {});
+    dem::Simulation sim = sandWithoutGravity({}, s);
     sim.setDecomposition(std::make_shared<dem::GhostExchange>(c, SlabDecomposition::uniform(2, 0, 0.0, 1.0),
                                                               s.loadBalanceThreshold));
     std::vector<dem::InsertedParticle> spheres;
