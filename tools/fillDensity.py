@@ -226,10 +226,10 @@ def stamp_figures(case, p, stamp, opening_area):
     t = columns["time"]
     force = columns["wallForce_stamp_z"]
     held = (t >= stamp["pressed_s"]) & (t <= stamp["released_s"])
-    if not np.any(held) or not np.any(force > 0):
-        raise ValueError(f"'{case}/dem/summary.csv': the stamp never pressed on the powder (no force on it while "
-                         f"held at {stamp['depth_m'] * 1e3:g} mm, {stamp['pressed_s']:g}-{stamp['released_s']:g} s): "
-                         "expected a run to past the stamp's hold")
+    if len(t) == 0 or t[-1] < stamp["released_s"] or not np.any(held):
+        print(f"fillDensity: no stamp figures: dem/summary.csv ends before the stamp's hold ends "
+              f"({stamp['released_s']:.4g} s)")
+        return {}
     mean = float(np.mean(force[held]))
     walls = float(-np.mean(columns["wallForce_dieWalls_z"][held]))
     when = f"held at {stamp['depth_m'] * 1e3:g} mm below the table, {stamp['pressed_s']:.4g}-{stamp['released_s']:.4g} s"

@@ -607,6 +607,38 @@ def defaults_from_a_die_case():
                 value("fillDensity.region.grid_0_0.mass"), float(np.sum(mass(rad[pos[:, 0] < 0]))), total,
                 1e-9 * total)
 
+    # With a pre-compaction stamp: its figures from dem/summary.csv's wall forces
+    stamp = {"depth_m": 0.003, "pressed_s": 0.4, "released_s": 0.6}
+    with open(os.path.join(case, "constant", "dieCase.json"), "w") as f:
+        json.dump({"timeline_s": {"filled": 0.5, "opening": 0.5}, "regionGrid": [2, 1], "openingArea_m2": 4e-4,
+                   "steps": {"stamp": stamp}}, f)
+    summary = os.path.join(case, "dem", "summary.csv")
+    value_of = lambda results, k: results.get(k, {}).get("value")  # noqa: E731
+
+    def with_stamp(rows):
+        with open(summary, "w") as f:
+            f.write("time,step,wallForce_stamp_z,wallForce_dieWalls_z,wallForce_dieFloors_z\n")
+            for t, stamp_z, walls_z in rows:
+                f.write(f"{t},{int(t * 1000)},{stamp_z},{walls_z},{-stamp_z - walls_z}\n")
+    # held 0.4-0.6 s: 10, 12, 14 N on the stamp, a quarter of it on the die wall; a peak of 20 N while pressing
+    with_stamp([(0.0, 0.0, 0.0), (0.3, 20.0, -5.0), (0.4, 10.0, -2.5), (0.5, 12.0, -3.0), (0.6, 14.0, -3.5),
+                (0.7, 0.0, 0.0)])
+    r = run_tool("-case", case, "-cell", H)
+    res = json.load(open(os.path.join(case, "postProcessing", "results.json")))
+    check("a die case with a stamp: peak force, pressure (mean force held / opening area), die wall's share",
+          r.returncode == 0 and value_of(res, "fillDensity.stamp.peakForce") == 20.0
+          and abs(value_of(res, "fillDensity.stamp.pressure") - 12.0 / 4e-4) < 1e-9
+          and abs(value_of(res, "fillDensity.stamp.dieWallShare") - 0.25) < 1e-12,
+          r.stderr.strip()[-300:] + str({k: v for k, v in res.items() if "stamp" in k}))
+    os.remove(os.path.join(case, "postProcessing", "results.json"))
+    with_stamp([(0.0, 0.0, 0.0), (0.3, 20.0, -5.0), (0.4, 10.0, -2.5), (0.5, 12.0, -3.0)])
+    r = run_tool("-case", case, "-cell", H)
+    res = json.load(open(os.path.join(case, "postProcessing", "results.json")))
+    check("a die case whose summary ends before the stamp is released: the map, no stamp figures, said so",
+          r.returncode == 0 and "fillDensity.mean" in res and not any("stamp" in k for k in res)
+          and "no stamp figures" in r.stdout, r.stdout.strip()[-200:])
+    os.remove(summary)
+
 
 # ------------------------------------------------------------------ refused options
 def outputs(case):
