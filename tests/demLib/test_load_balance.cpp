@@ -483,6 +483,30 @@ TEST(Rebalance, SimulationBalancesWorkWhenAsked) {
     });
 }
 
+// Weighted on every rank, one of which owns nothing (the die filling's start): the
+// empty rank takes the same collectives (an empty weight list there is no weights).
+TEST(Rebalance, WeightsWithAnEmptyRank) {
+    Communicator::runThreadGroup(2, [](const Communicator& c) {
+        const SlabDecomposition slabs(2, 0, {0.5});
+        dem::ParticleStore p;
+        std::vector<double> w;
+        for (int i = 0; i < 1000; ++i) {
+            const Vec3 x(0.6 + 0.3 * i / 1000.0, 0.0, 0.0);
+            if (slabs.ownerOf(x, 0) != c.rank()) continue;
+            p.add(i, x, Vec3::Zero(), 1e-4, 2500.0, 0);
+            w.push_back(i < 500 ? 3.0 : 1.0);
+        }
+        ASSERT_EQ(p.size(), c.rank() == 1 ? 1000u : 0u);
+        dem::GhostExchange exchange(c, slabs);
+        const auto report = exchange.rebalanceByWeight(p, w);
+        EXPECT_TRUE(report.weighted);
+        EXPECT_TRUE(report.recut);
+        EXPECT_DOUBLE_EQ(report.imbalance, 2.0);
+        EXPECT_LE(report.loadImbalanceAfter, 1.02);
+        EXPECT_NEAR(report.cuts[0], 0.6 + 0.3 * (1000.0 / 3.0) / 1000.0, 0.01);  // half of 2000 below it
+    });
+}
+
 TEST(Rebalance, SlabsChangeOnlyWithoutGhosts) {
     Communicator::runThreadGroup(2, [](const Communicator& c) {
         const SlabDecomposition slabs(2, 0, {0.5});

@@ -79,6 +79,16 @@ void GhostExchange::setRebalanceThreshold(double threshold) {
 
 GhostExchange::RebalanceReport GhostExchange::rebalanceIfNeeded(const ParticleStore& p,
                                                                 const std::vector<double>& weights) {
+    return rebalance(p, weights, !weights.empty());
+}
+
+GhostExchange::RebalanceReport GhostExchange::rebalanceByWeight(const ParticleStore& p,
+                                                                const std::vector<double>& weights) {
+    return rebalance(p, weights, true);
+}
+
+GhostExchange::RebalanceReport GhostExchange::rebalance(const ParticleStore& p, const std::vector<double>& weights,
+                                                        bool weighted) {
     if (ghostCount_ != 0) throw RuntimeError("demLib ghost exchange: rebalanceIfNeeded() called with ghosts present");
     RebalanceReport report;
     if (!balancingEnabled()) {
@@ -87,7 +97,7 @@ GhostExchange::RebalanceReport GhostExchange::rebalanceIfNeeded(const ParticleSt
         return report;
     }
     const std::size_t owned = p.size();
-    if (!weights.empty() && weights.size() != owned)
+    if ((weighted || !weights.empty()) && weights.size() != owned)
         throw InputError("demLib ghost exchange: " + std::to_string(weights.size()) + " load weights for " +
                          std::to_string(owned) + " owned particles; expected one each (or none)");
     const int ranks = communicator_.size();
@@ -96,7 +106,7 @@ GhostExchange::RebalanceReport GhostExchange::rebalanceIfNeeded(const ParticleSt
     report.maxOwned = static_cast<std::int64_t>(communicator_.max(static_cast<double>(owned)));
     report.meanOwned = static_cast<double>(total) / ranks;
     bool recut = false;
-    if (weights.empty()) {
+    if (!weighted) {
         report.imbalance = total > 0 ? report.maxOwned / report.meanOwned : 0.0;
         recut = total > 0 && report.imbalance > rebalanceThreshold_;
     } else {
@@ -113,9 +123,10 @@ GhostExchange::RebalanceReport GhostExchange::rebalanceIfNeeded(const ParticleSt
         const int axis = slabs_.axis();
         std::vector<double> coordinates(owned);
         for (std::size_t i = 0; i < owned; ++i) coordinates[i] = p.position[i][axis];
+        // (On a rank without particles `weights` is empty and reads as unit weights: none.)
         setSlabs(SlabDecomposition::balanced(communicator_, axis, coordinates, weights));
         ++recuts_;
-        if (!weights.empty()) {
+        if (weighted) {
             // The load each rank will hold: the weights by their new owner.
             std::vector<double> load(ranks, 0.0);
             const int me = rank();
@@ -129,7 +140,7 @@ GhostExchange::RebalanceReport GhostExchange::rebalanceIfNeeded(const ParticleSt
             report.loadImbalanceAfter = total > 0.0 ? largest / (total / ranks) : 1.0;
         }
     }
-    report.weighted = !weights.empty();
+    report.weighted = weighted;
     report.recut = recut;
     report.cuts = slabs_.interiorCuts();
     lastRebalance_ = report;

@@ -482,7 +482,9 @@ void Simulation::updatePairList() {
             settings_.loadBalanceWeight == LoadBalanceWeight::Work && decomposition_->balancingEnabled();
         const std::vector<double> work = byWork ? ownedWork() : std::vector<double>();
         decomposition_->dropGhosts(particles_, pairs_, wallContacts_);
-        const bool recut = decomposition_->rebalanceIfNeeded(particles_, work).recut;
+        const bool recut = (byWork ? decomposition_->rebalanceByWeight(particles_, work)
+                                   : decomposition_->rebalanceIfNeeded(particles_))
+                               .recut;
         decomposition_->migrate(particles_);
         if (recut) decomposition_->noteBalanceAfterMigration(particles_);
     }

@@ -133,6 +133,9 @@ public:
     // re-cut adds a few rounds of small exchanges, bounded by the rank count.
     // Collective.
     RebalanceReport rebalanceIfNeeded(const ParticleStore& particles, const std::vector<double>& weights = {});
+    // The same with weights on every rank, also on a rank that owns no particle
+    // (an empty `weights` there): every rank must take the weighted path.
+    RebalanceReport rebalanceByWeight(const ParticleStore& particles, const std::vector<double>& weights);
     // Re-cuts so far, and the report of the latest rebalanceIfNeeded call.
     std::size_t recutCount() const { return recuts_; }
     const RebalanceReport& lastRebalance() const { return lastRebalance_; }
@@ -160,6 +163,7 @@ private:
     std::vector<std::size_t> updateSendBytes_, updateReceiveBytes_;
     std::vector<PairRecord> pairStash_;
     std::vector<WallRecord> wallStash_;
+    RebalanceReport rebalance(const ParticleStore& particles, const std::vector<double>& weights, bool weighted);
     double rebalanceThreshold_ = defaultRebalanceThreshold;
     std::size_t recuts_ = 0;
     RebalanceReport lastRebalance_;
