@@ -411,7 +411,7 @@ TEST(Rebalance, WeightsDecideTheLoad) {
         }
         dem::GhostExchange exchange(c, slabs);
         EXPECT_FALSE(exchange.rebalanceIfNeeded(p).recut) << "equal counts";
-        const auto report = exchange.rebalanceIfNeeded(p, w);
+        const auto report = exchange.rebalanceByWeight(p, w);
         EXPECT_TRUE(report.recut);
         EXPECT_DOUBLE_EQ(report.imbalance, 1.6);  // 4 / 2.5
         // Half the weight, 5000, lies below x = 5000 / (4 n) = 0.3125.
@@ -420,7 +420,7 @@ TEST(Rebalance, WeightsDecideTheLoad) {
         double load = 0.0;
         for (std::size_t i = 0; i < p.size(); ++i) load += p.position[i].x() < 0.5 ? 4.0 : 1.0;
         EXPECT_LE(c.max(load), 1.01 * 5000.0 + 3 * 4.0);
-        EXPECT_THROW(exchange.rebalanceIfNeeded(p, {1.0}), dem::InputError);
+        EXPECT_THROW(exchange.rebalanceByWeight(p, {1.0}), dem::InputError);
     });
 }
 

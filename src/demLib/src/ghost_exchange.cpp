@@ -77,9 +77,8 @@ void GhostExchange::setRebalanceThreshold(double threshold) {
     rebalanceThreshold_ = threshold;
 }
 
-GhostExchange::RebalanceReport GhostExchange::rebalanceIfNeeded(const ParticleStore& p,
-                                                                const std::vector<double>& weights) {
-    return rebalance(p, weights, !weights.empty());
+GhostExchange::RebalanceReport GhostExchange::rebalanceIfNeeded(const ParticleStore& p) {
+    return rebalance(p, {}, false);
 }
 
 GhostExchange::RebalanceReport GhostExchange::rebalanceByWeight(const ParticleStore& p,
@@ -97,7 +96,7 @@ GhostExchange::RebalanceReport GhostExchange::rebalance(const ParticleStore& p, 
         return report;
     }
     const std::size_t owned = p.size();
-    if ((weighted || !weights.empty()) && weights.size() != owned)
+    if (weighted && weights.size() != owned)
         throw InputError("demLib ghost exchange: " + std::to_string(weights.size()) + " load weights for " +
                          std::to_string(owned) + " owned particles; expected one each (or none)");
     const int ranks = communicator_.size();

@@ -125,16 +125,15 @@ public:
     bool balancingEnabled() const { return rebalanceThreshold_ > 0.0 && rebalanceThreshold_ < 1e300; }
 
     // With no ghosts present (after dropGhosts, before migrate): the owned
-    // counts (or summed `weights`, one per owned particle, e.g. contact
-    // counts) of all ranks; if max/mean exceeds the threshold, new cuts along
+    // counts of all ranks; if max/mean exceeds the threshold, new cuts along
     // the same axis from the owned positions (SlabDecomposition::balanced:
     // max/mean owned <= 1.01 + 2/mean after the migrate that must follow).
-    // Costs two reductions when no re-cut is needed (five with weights); a
-    // re-cut adds a few rounds of small exchanges, bounded by the rank count.
-    // Collective.
-    RebalanceReport rebalanceIfNeeded(const ParticleStore& particles, const std::vector<double>& weights = {});
-    // The same with weights on every rank, also on a rank that owns no particle
-    // (an empty `weights` there): every rank must take the weighted path.
+    // Costs two reductions when no re-cut is needed; a re-cut adds a few
+    // rounds of small exchanges, bounded by the rank count.  Collective.
+    RebalanceReport rebalanceIfNeeded(const ParticleStore& particles);
+    // The same for the summed `weights`, one per owned particle (e.g. contact
+    // counts; none on a rank that owns none): five reductions without a
+    // re-cut.  Every rank must call the same one of the two.
     RebalanceReport rebalanceByWeight(const ParticleStore& particles, const std::vector<double>& weights);
     // Re-cuts so far, and the report of the latest rebalanceIfNeeded call.
     std::size_t recutCount() const { return recuts_; }
