@@ -50,7 +50,8 @@ fillDensity.vtk (STRUCTURED_POINTS; open in ParaView), regions.csv; and adds <N>
 .max, .min, .maxMinusMin, .coefficientOfVariation, .time, .cell, ... and the regions'
 <N>.region.<NAME>.mass/.bulkDensity to CASE/postProcessing/results.json (the keys that
 other tools wrote are kept); with a pre-compaction stamp (dieCase.json steps/stamp) also
-<N>.stamp.peakForce, .pressure and .dieWallShare from dem/summary.csv's wall forces.  Units: SI (m, kg, kg/m3, s)."""
+<N>.stamp.peakForce, .pressure and .dieWallShare from dem/summary.csv's wall forces (and, for a
+stamp of given mass, .depth: how far below the table it came to rest).  Units: SI (m, kg, kg/m3, s)."""
 import csv
 import json
 import os
@@ -232,8 +233,12 @@ def stamp_figures(case, p, stamp, opening_area):
         return {}
     mean = float(np.mean(force[held]))
     walls = float(-np.mean(columns["wallForce_dieWalls_z"][held]))
-    when = f"held at {stamp['depth_m'] * 1e3:g} mm below the table, {stamp['pressed_s']:.4g}-{stamp['released_s']:.4g} s"
-    return {
+    window = f"{stamp['pressed_s']:.4g}-{stamp['released_s']:.4g} s"
+    if "mass_kg" in stamp:
+        when = f"resting under its weight ({stamp['mass_kg']:g} kg), {window}"
+    else:
+        when = f"held at {stamp['depth_m'] * 1e3:g} mm below the table, {window}"
+    out = {
         f"{p}.stamp.peakForce": {"value": float(np.max(force)), "unit": "N",
                                  "description": "largest force of the powder on the pre-compaction stamp"},
         f"{p}.stamp.pressure": {"value": mean / opening_area, "unit": "Pa",
@@ -241,6 +246,24 @@ def stamp_figures(case, p, stamp, opening_area):
         f"{p}.stamp.dieWallShare": {"value": walls / mean if mean > 0 else None, "unit": "-",
                                     "description": f"the die side walls' share of the stamp force (friction), {when}"},
     }
+    if "mass_kg" in stamp:
+        # A stamp of given weight sinks as far as the powder lets it: how far is the result.
+        offset = columns.get("wallOffset_stamp")
+        if offset is None:
+            print("fillDensity: no stamp depth: dem/summary.csv has no column wallOffset_stamp")
+            return out
+        depth = float(np.mean(offset[held]))
+        stopped = depth >= stamp["stroke_m"] * (1 - 1e-9)
+        out[f"{p}.stamp.depth"] = {
+            "value": depth, "unit": "m",
+            "description": f"how far below the table the stamp stood, {when}" +
+                           (f"; it stood on its stop ({stamp['stroke_m'] * 1e3:g} mm): the powder did not carry it"
+                            if stopped else "")}
+        weight = stamp["mass_kg"] * 9.81
+        if not stopped and abs(mean - weight) > 0.1 * weight:
+            print(f"fillDensity: the stamp was not at rest {window}: the powder carried {mean:.4g} N of its "
+                  f"{weight:.4g} N (a longer hold, steps/stamp/hold, lets it settle)")
+    return out
 
 
 def die_case(case):
@@ -263,7 +286,8 @@ def die_case(case):
         out["regions"] = {str(k): [float(x) for x in v] for k, v in (d.get("regions_m") or {}).items()}
         out["stamp"] = (d.get("steps") or {}).get("stamp")
         if out["stamp"] is not None:
-            out["stamp"] = {k: float(out["stamp"][k]) for k in ("depth_m", "pressed_s", "released_s")}
+            keys = ("mass_kg", "stroke_m") if "mass_kg" in out["stamp"] else ("depth_m",)
+            out["stamp"] = {k: float(out["stamp"][k]) for k in keys + ("pressed_s", "released_s")}
             out["openingArea"] = float(d["openingArea_m2"])
         if any(len(v) != 4 for v in out["regions"].values()):
             raise ValueError("regions_m")

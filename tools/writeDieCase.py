@@ -47,6 +47,8 @@ SETTLE = 0.3                 # s after the last shoe motion before the opening, 
 STAMP_SPEED = 0.01           # m/s, the pre-compaction stamp's default pressing speed
 STAMP_APPROACH_SPEED = 0.2   # m/s, the stamp down to the table and back up
 STAMP_HOLD = 0.2             # s, the stamp held at its depth (default)
+STAMP_WEIGHT_SPEED = 0.02    # m/s, a stamp of given mass: lowered onto the powder no faster (default)
+STAMP_WEIGHT_HOLD = 0.5      # s, a stamp of given mass: from the table until it is raised (default)
 
 
 class DictError(ValueError):
@@ -295,17 +297,35 @@ def write_case(case, path, rel, a):
     stamp = None
     if isinstance(steps.d.get("stamp"), dict):
         press = steps.sub("stamp")
-        press.check_keys(["depth", "speed", "hold"])
-        stamp = {"depth": press.number("depth", low=0.0, low_open=True) * scale,
-                 "speed": press.number("speed", STAMP_SPEED, low=0.0, low_open=True, high=STAMP_APPROACH_SPEED),
-                 "hold": press.number("hold", STAMP_HOLD, low=0.0)}
-        if stamp["depth"] >= 0.5 * depth:
-            press.fail("depth", f"a depth below the table (in {unit}) less than half the cavity's "
-                                f"{depth / scale:.4g} {unit}", stamp["depth"] / scale)
+        press.check_keys(["depth", "mass", "speed", "hold"])
+        given = [k for k in ("depth", "mass") if k in press.d]
+        if not given:
+            press.fail("depth", f"depth D (the stamp pressed D {unit} below the table) or mass M (a stamp of "
+                                "M kg resting on the powder under its weight)")
+        if len(given) == 2:
+            press.fail("mass", "either depth (driven to a depth) or mass (resting under its weight), not both",
+                       "both")
+        if given == ["depth"]:
+            stamp = {"depth": press.number("depth", low=0.0, low_open=True) * scale,
+                     "speed": press.number("speed", STAMP_SPEED, low=0.0, low_open=True, high=STAMP_APPROACH_SPEED),
+                     "hold": press.number("hold", STAMP_HOLD, low=0.0)}
+            if stamp["depth"] >= 0.5 * depth:
+                press.fail("depth", f"a depth below the table (in {unit}) less than half the cavity's "
+                                    f"{depth / scale:.4g} {unit}", stamp["depth"] / scale)
+        else:
+            # Lowered by a hoist onto the powder, resting under its weight, stopped at half the
+            # cavity's depth at the latest (docs/walls.md, "A wall under load").
+            stamp = {"mass": press.number("mass", low=0.0, low_open=True, high=1000.0),
+                     "speed": press.number("speed", STAMP_WEIGHT_SPEED, low=0.0, low_open=True,
+                                           high=STAMP_APPROACH_SPEED),
+                     "hold": press.number("hold", STAMP_WEIGHT_HOLD, low=0.0, low_open=True),
+                     "stroke": 0.5 * depth}
     elif steps.switch("stamp", False):
         steps.fail("stamp", "no, or stamp { depth D; speed V; hold T; }: how far below the table the stamp "
                             f"presses (D, in {unit}), at V m/s (default {STAMP_SPEED:g}), held T s (default "
-                            f"{STAMP_HOLD:g})", "yes")
+                            f"{STAMP_HOLD:g}); or stamp {{ mass M; speed V; hold T; }}: a stamp of M kg lowered "
+                            f"at V m/s (default {STAMP_WEIGHT_SPEED:g}) onto the powder, raised T s (default "
+                            f"{STAMP_WEIGHT_HOLD:g}) after it reached the table", "yes")
     end_xy = path_xy[-1]
     if stamp and np.all(end_xy - half < ohi[:2]) and np.all(end_xy + half > olo[:2]):
         steps.fail("stamp", "no stamp, or a shoe path that ends beside the opening: the stamp comes down over "
@@ -346,9 +366,19 @@ def write_case(case, path, rel, a):
         stamp["park"] = 1.2 * height
         stamp["down"] = open_start
         stamp["onTable"] = stamp["down"] + stamp["park"] / STAMP_APPROACH_SPEED
-        stamp["pressed"] = stamp["onTable"] + stamp["depth"] / stamp["speed"]
-        stamp["released"] = stamp["pressed"] + stamp["hold"]
-        stamp["up"] = stamp["released"] + (stamp["park"] + stamp["depth"]) / STAMP_APPROACH_SPEED
+        if "mass" in stamp:
+            # From the table it hangs on the hoist (at most `speed`) until the powder carries
+            # it; raised `hold` after it reached the table, back there within stroke / speed.
+            # Its figures are taken over the hold's second half, when it rests.
+            stamp["pressed"] = stamp["onTable"] + 0.5 * stamp["hold"]
+            stamp["released"] = stamp["onTable"] + stamp["hold"]
+            # (1 us later: clear of the load's end after the times are rounded to 9 digits)
+            stamp["back"] = stamp["released"] + stamp["stroke"] / stamp["speed"] + 1e-6
+            stamp["up"] = stamp["back"] + stamp["park"] / STAMP_APPROACH_SPEED
+        else:
+            stamp["pressed"] = stamp["onTable"] + stamp["depth"] / stamp["speed"]
+            stamp["released"] = stamp["pressed"] + stamp["hold"]
+            stamp["up"] = stamp["released"] + (stamp["park"] + stamp["depth"]) / STAMP_APPROACH_SPEED
         open_start = stamp["up"] + SETTLE
     open_end = open_start + 1.2 * depth / OPENING_SPEED
     end_time = (open_end if lower else open_start) + SETTLE
@@ -371,7 +401,9 @@ def write_case(case, path, rel, a):
         "powder": {"mass_kg": mass, "coarseGrain": grain, "waterContent": water, "seed": int(seed)},
         "steps": {"air": air, "aeration": aeration, "lowerDieWall": lower,
                   "stamp": None if not stamp else {
-                      "depth_m": stamp["depth"], "speed_m_s": stamp["speed"], "hold_s": stamp["hold"],
+                      **({"mass_kg": stamp["mass"], "stroke_m": stamp["stroke"], "backOnTable_s": stamp["back"]}
+                         if "mass" in stamp else {"depth_m": stamp["depth"]}),
+                      "speed_m_s": stamp["speed"], "hold_s": stamp["hold"],
                       "parkedAt_m": stamp["park"], "comesDown_s": stamp["down"], "onTable_s": stamp["onTable"],
                       "pressed_s": stamp["pressed"], "released_s": stamp["released"], "up_s": stamp["up"]}},
         "timeStep_s": step, "regionGrid": [int(grid[0]), int(grid[1])],
@@ -452,21 +484,29 @@ def write_case(case, path, rel, a):
     stamp_wall = ""
     if stamp:
         a_, v_ = STAMP_APPROACH_SPEED, stamp["speed"]
+        if "mass" in stamp:
+            press_text = (f"            press {{ type load; start {stamp['onTable']:.9g}; raise {stamp['released']:.9g}; "
+                          f"direction (0 0 -1); mass {stamp['mass']:.9g}; speed {v_:g}; "
+                          f"stroke {stamp['stroke']:.9g}; }}\n")
+            up_start = stamp["back"]
+        else:
+            press_text = (f"            press {{ type translate; start {stamp['onTable']:.9g}; end {stamp['pressed']:.9g}; "
+                          f"velocity (0 0 {-v_:g}); }}\n")
+            up_start = stamp["released"]
         stamp_wall = (
             "    // The pre-compaction stamp: the opening's shape, parked above the shoe\n"
             "    stamp\n    {\n        type stl; file \"constant/triSurface/stamp.stl\"; material steel;\n"
             "        motion\n        {\n"
             f"            down  {{ type translate; start {stamp['down']:.9g}; end {stamp['onTable']:.9g}; "
             f"velocity (0 0 {-a_:g}); }}\n"
-            f"            press {{ type translate; start {stamp['onTable']:.9g}; end {stamp['pressed']:.9g}; "
-            f"velocity (0 0 {-v_:g}); }}\n"
-            f"            up    {{ type translate; start {stamp['released']:.9g}; end {stamp['up']:.9g}; "
+            + press_text +
+            f"            up    {{ type translate; start {up_start:.9g}; end {stamp['up']:.9g}; "
             f"velocity (0 0 {a_:g}); }}\n"
             "        }\n    }\n")
     dem = f"""FoamFile {{ version 2.0; format ascii; class dictionary; object demProperties; }}
 // Written by writeDieCase.py from {rel}; edit that file and run ./Allrun again.
 // Timeline: shoe filled by {fill_end:.4g} s; shoe moves {segments[0][0]:.4g}-{pass_end:.4g} s;
-// {"stamp down " + f"{stamp['down']:.4g} s, pressed {stamp['depth'] * 1e3:.4g} mm {stamp['onTable']:.4g}-{stamp['pressed']:.4g} s, up by {stamp['up']:.4g} s; " if stamp else ""}{"die wall and table lowered " + f"{open_start:.4g}-{open_end:.4g} s; " if lower else ""}end {end_time:.4g} s.
+// {"stamp down " + f"{stamp['down']:.4g} s, " + (f"{stamp['mass']:.4g} kg resting on the powder {stamp['onTable']:.4g}-{stamp['released']:.4g} s" if "mass" in stamp else f"pressed {stamp['depth'] * 1e3:.4g} mm {stamp['onTable']:.4g}-{stamp['pressed']:.4g} s") + f", up by {stamp['up']:.4g} s; " if stamp else ""}{"die wall and table lowered " + f"{open_start:.4g}-{open_end:.4g} s; " if lower else ""}end {end_time:.4g} s.
 
 simulation
 {{

@@ -76,10 +76,25 @@ def main(name, case):
             weight = 9.81 * cavity
             residual = max(abs(f(r, "stamp") + f(r, "dieFloors") + f(r, "dieWalls") + weight) for r in held)
             before = next(float(r["mass_cavity"]) for r in reversed(rows) if float(r["time"]) <= stamp["comesDown_s"])
-            check(f"stamp held {stamp['depth_m'] * 1e3:g} mm in: pressed by the powder ({min(pressed):.2f}-"
-                  f"{max(pressed):.2f} N), balanced by floors + die wall - the powder's weight ({weight:.3f} N) "
-                  f"to {residual:.3f} N (1 % allowed)",
-                  held and min(pressed) > 10 * weight and residual <= 0.01 * sum(pressed) / len(pressed))
+            mean_force = sum(pressed) / len(pressed) if held else 0.0
+            if "mass_kg" in stamp:
+                # Resting under its weight: the powder carries it, and it stands as deep as the
+                # powder let it sink, short of its stop (summary's wallOffset_stamp = results.json's depth).
+                stamp_weight = 9.81 * stamp["mass_kg"]
+                sank = [float(r["wallOffset_stamp"]) for r in held]
+                depth = number("stamp.depth")
+                check(f"stamp of {stamp['mass_kg']:g} kg at rest on the powder: it carries {mean_force:.3f} N of its "
+                      f"weight {stamp_weight:.3f} N (5 % allowed)",
+                      held and abs(mean_force - stamp_weight) <= 0.05 * stamp_weight)
+                check(f"stamp: it sank {depth and depth * 1e3:.3f} mm below the table (results.json), into the "
+                      f"powder and short of its stop ({stamp['stroke_m'] * 1e3:g} mm)",
+                      isinstance(depth, float) and 0 < depth < stamp["stroke_m"]
+                      and abs(depth - sum(sank) / len(sank)) <= 1e-9)
+            else:
+                check(f"stamp held {stamp['depth_m'] * 1e3:g} mm in: pressed by the powder ({min(pressed):.2f}-"
+                      f"{max(pressed):.2f} N)", held and min(pressed) > 10 * weight)
+            check(f"stamp: balanced by floors + die wall - the powder's weight ({weight:.3f} N) to {residual:.3f} N "
+                  f"(1 % of its force allowed)", held and residual <= 0.01 * mean_force)
             walls = -sum(f(r, "dieWalls") for r in held) / sum(pressed)
             check(f"stamp: the die wall carries part of it by friction ({walls:.2f}), the floors the rest",
                   0.05 < walls < 0.95)

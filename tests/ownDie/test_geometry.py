@@ -274,7 +274,33 @@ results { regionGrid (2 2); regions { near (-20 -20 0 20); } }
           and abs(tl["opening"] - (st["up_s"] + 0.3)) < 1e-12 and tl["filled"] == tl["opening"]
           and abs(segments[2][0] - st["released_s"]) < 1e-9, str(st))
 
+    # A stamp of given weight: 0.5 kg lowered from the table at 0.02 m/s (a load: the DEM moves
+    # it under the powder's force), raised 0.4 s after it reached the table, stopped at half the
+    # cavity's depth (20 mm deep: 10 mm) at the latest, back on the table by then + 10 mm / 0.02 m/s
+    weighted = good.replace("lowerDieWall yes;", "lowerDieWall yes; stamp { mass 0.5; speed 0.02; hold 0.4; }")
+    write_dict(weighted)
+    rc, out = run([os.path.join(ROOT, "tools", "writeDieCase.py"), "-case", case], tmp)
+    summary = json.load(open(os.path.join(case, "constant", "dieCase.json")))
+    dem = open(os.path.join(case, "constant", "demProperties.orig")).read()
+    st, tl = summary["steps"]["stamp"], summary["timeline_s"]
+    load = re.search(r"press +\{ type load; start ([-\d.e]+); raise ([-\d.e]+); direction \(0 0 -1\); "
+                     r"mass ([-\d.e]+); speed ([-\d.e]+); stroke ([-\d.e]+); \}", dem)
+    moves = [tuple(float(v) for v in m) for m in re.findall(
+        r"(?:down|up) +\{ type translate; start ([-\d.e]+); end ([-\d.e]+); velocity \(0 0 ([-\d.e]+)\); \}", dem)]
+    load = [float(v) for v in load.groups()] if load else []
+    check("stamp of given mass: a load of 0.5 kg from the table, raised after 0.4 s, stopped at 10 mm, then back up",
+          rc == 0 and len(load) == 5 and len(moves) == 2 and st["mass_kg"] == 0.5 and abs(st["stroke_m"] - 0.01) < 1e-15
+          and abs(load[0] - st["onTable_s"]) < 1e-9 and abs(load[1] - load[0] - 0.4) < 1e-9 and load[2] == 0.5
+          and load[3] == 0.02 and abs(load[4] - 0.01) < 1e-12 and abs(moves[0][1] - load[0]) < 1e-9
+          and 0 < moves[1][0] - (load[1] + load[4] / load[3]) < 1e-5
+          and abs((moves[0][1] - moves[0][0]) * moves[0][2] + 0.036) < 1e-9
+          and abs((moves[1][1] - moves[1][0]) * moves[1][2] - 0.036) < 1e-9
+          and abs(st["pressed_s"] - (st["onTable_s"] + 0.2)) < 1e-12 and abs(tl["opening"] - (st["up_s"] + 0.3)) < 1e-12,
+          out.strip()[-200:] + " " + str(load) + " " + str(moves))
+
     bad = [
+        ("a stamp with a depth and a mass", stamped.replace("depth 4;", "depth 4; mass 1;"), "steps/stamp/mass"),
+        ("a stamp of no mass", weighted.replace("mass 0.5;", "mass 0;"), "steps/stamp/mass"),
         ("a stamp without its depth", good.replace("lowerDieWall yes;", "lowerDieWall yes; stamp yes;"), "steps/stamp"),
         ("a stamp deeper than half the cavity", stamped.replace("depth 4;", "depth 10;"), "steps/stamp/depth"),
         ("a stamp with an unknown keyword", stamped.replace("hold 0.1;", "hold 0.1; force 5;"), "steps/stamp/force"),

@@ -637,6 +637,40 @@ def defaults_from_a_die_case():
     check("a die case whose summary ends before the stamp is released: the map, no stamp figures, said so",
           r.returncode == 0 and "fillDensity.mean" in res and not any("stamp" in k for k in res)
           and "no stamp figures" in r.stdout, r.stdout.strip()[-200:])
+    os.remove(os.path.join(case, "postProcessing", "results.json"))
+
+    # A stamp of given mass (0.5 kg, its figures over 0.4-0.6 s): where it stood is the mean of the
+    # summary's wallOffset_stamp then; on its stop (the stroke), that is said
+    def weighted(rows, stroke=0.01):
+        with open(os.path.join(case, "constant", "dieCase.json"), "w") as f:
+            json.dump({"timeline_s": {"filled": 0.5, "opening": 0.5}, "regionGrid": [2, 1], "openingArea_m2": 4e-4,
+                       "steps": {"stamp": {"mass_kg": 0.5, "stroke_m": stroke, "pressed_s": 0.4,
+                                           "released_s": 0.6}}}, f)
+        with open(summary, "w") as f:
+            f.write("time,step,wallForce_stamp_z,wallForce_dieWalls_z,wallForce_dieFloors_z,wallOffset_stamp\n")
+            for t, stamp_z, walls_z, offset in rows:
+                f.write(f"{t},{int(t * 1000)},{stamp_z},{walls_z},{-stamp_z - walls_z},{offset}\n")
+        r = run_tool("-case", case, "-cell", H)
+        res = json.load(open(os.path.join(case, "postProcessing", "results.json")))
+        os.remove(os.path.join(case, "postProcessing", "results.json"))
+        return r, res
+    resting = [(0.0, 0.0, 0.0, 0.0), (0.3, 6.0, -1.0, 0.002), (0.4, 4.9, -1.0, 0.0031), (0.5, 4.91, -1.2, 0.0030),
+               (0.6, 4.9, -1.1, 0.0029), (0.7, 0.0, 0.0, 0.0)]
+    r, res = weighted(resting)
+    check("a stamp of given mass: its depth (mean offset while resting), pressure, share; no stop said",
+          r.returncode == 0 and abs(value_of(res, "fillDensity.stamp.depth") - 0.003) < 1e-12
+          and abs(value_of(res, "fillDensity.stamp.pressure") - 4.9033333333333 / 4e-4) < 1e-6
+          and abs(value_of(res, "fillDensity.stamp.dieWallShare") - 1.1 / 4.9033333333333) < 1e-9
+          and "stop" not in res["fillDensity.stamp.depth"]["description"] and "not at rest" not in r.stdout,
+          r.stdout.strip()[-300:] + str({k: v for k, v in res.items() if "stamp" in k}))
+    r, res = weighted([(t, 0.0, 0.0, min(o * 4, 0.004)) for t, _, _, o in resting], stroke=0.004)
+    check("a stamp of given mass that reached its stop: the depth says so (the powder did not carry it)",
+          r.returncode == 0 and value_of(res, "fillDensity.stamp.depth") == 0.004
+          and "stood on its stop" in res["fillDensity.stamp.depth"]["description"],
+          str({k: v for k, v in res.items() if "stamp" in k}))
+    r, res = weighted([(t, f * 0.5, w, o) for t, f, w, o in resting])
+    check("a stamp of given mass the powder carried only half of: 'not at rest' said",
+          r.returncode == 0 and "not at rest" in r.stdout, r.stdout.strip()[-300:])
     os.remove(summary)
 
 

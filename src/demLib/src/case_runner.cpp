@@ -543,6 +543,9 @@ void CaseRunner::writeSummaryHeader() {
     // Force of the particles on each wall [N] (contacts and liquid bridges).
     for (const Wall& w : simulation_->walls())
         for (const char* axis : {"x", "y", "z"}) summary_ << ",wallForce_" << w.name << "_" << axis;
+    // Where each wall under load stands: its offset along the load's direction [m].
+    for (const Wall& w : simulation_->walls())
+        if (w.motion.hasLoad()) summary_ << ",wallOffset_" << w.name;
     summary_ << "\n";
 }
 
@@ -576,6 +579,8 @@ void CaseRunner::writeSummaryLine() {
     }
     for (double m : regionMass) summary_ << "," << m;
     for (const Vec3& f : totals.wallForces) summary_ << "," << f.x() << "," << f.y() << "," << f.z();
+    for (const Wall& w : s.walls())  // the same on every rank
+        if (w.motion.hasLoad()) summary_ << "," << w.motion.loadState().offset;
     summary_ << "\n";
     summary_.flush();
 }

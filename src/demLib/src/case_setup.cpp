@@ -176,8 +176,21 @@ WallMotion readMotion(const Dictionary& wall) {
         const Dictionary& m = wall.subDict("motion");
         for (const std::string& segmentName : m.keys()) {
             const Dictionary& s = m.subDict(segmentName);
-            const std::string type = s.getChoice("type", {"translate", "rotate"});
+            const std::string type = s.getChoice("type", {"translate", "rotate", "load"});
             const double start = s.getNonNegative("start");
+            if (type == "load") {
+                // Lowered from `start`, resting under its weight, drawn back from `raise` (WallLoad).
+                WallLoad load;
+                load.tStart = start;
+                load.tRaise = s.getPositive("raise");
+                if (!(load.tRaise > start)) invalid(s, "raise", "expected raise > start");
+                load.direction = unitVector(s, "direction");
+                load.mass = s.getPositive("mass");
+                load.speed = s.getPositive("speed");
+                load.stroke = s.getPositive("stroke");
+                motion.addLoad(load);
+                continue;
+            }
             const double end = s.getPositive("end");
             if (!(end > start)) invalid(s, "end", "expected end > start");
             if (type == "translate") {
@@ -201,10 +214,23 @@ void requireWallSpeedsChecked(const Dictionary& wall, const Wall& w, const Simul
     const Dictionary& motion = wall.subDict("motion");
     const std::vector<std::string> segments = motion.keys();  // in the order readMotion added them
     const AxisAlignedBox* domain = settings.domain ? &*settings.domain : nullptr;
-    for (std::size_t k = 0; k < w.motion.segments().size() && k < segments.size(); ++k) {
+    if (w.motion.hasLoad() && w.motion.load().speed > settings.impactVelocity) {
+        std::ostringstream e;
+        e.precision(6);
+        e << "the wall is lowered and raised at " << w.motion.load().speed << " m/s, faster than 'impactVelocity' ("
+          << settings.impactVelocity << " m/s in simulation, the largest particle speed the time step is checked "
+          << "for); expected a speed <= impactVelocity";
+        for (const std::string& name : segments)
+            if (motion.subDict(name).get<std::string>("type") == "load") invalid(motion.subDict(name), "speed", e.str());
+    }
+    std::size_t k = 0;
+    for (const std::string& name : segments) {
+        if (motion.subDict(name).get<std::string>("type") == "load") continue;
+        if (k >= w.motion.segments().size()) break;
         const double speed = w.largestSpeed(k, domain);
-        if (!(speed > settings.impactVelocity)) continue;
         const bool turns = w.motion.segments()[k].kind == MotionSegment::Kind::Rotate;
+        ++k;
+        if (!(speed > settings.impactVelocity)) continue;
         std::ostringstream e;
         e.precision(6);
         if (turns && !std::isfinite(speed))
@@ -217,7 +243,7 @@ void requireWallSpeedsChecked(const Dictionary& wall, const Wall& w, const Simul
               << " m/s in simulation, the largest particle speed the time step is checked for); expected a "
               << (turns ? "slower turn" : "speed") << " <= impactVelocity, or impactVelocity >= " << speed
               << " (the time step is then checked for impacts at that speed)";
-        invalid(motion.subDict(segments[k]), turns ? "angularVelocity" : "velocity", e.str());
+        invalid(motion.subDict(name), turns ? "angularVelocity" : "velocity", e.str());
     }
 }
 

@@ -698,6 +698,30 @@ void Simulation::computeForces(bool forcesReset) {
     }
 }
 
+void Simulation::advanceWallLoads() {
+    bool loaded = false;
+    for (const Wall& w : walls_) loaded = loaded || (w.motion.hasLoad() && w.motion.isMovingAt(time_));
+    if (!loaded) {
+        for (Wall& w : walls_) w.motion.advanceLoad(time_, settings_.timeStep, 0.0, 0.0);  // zero outside
+        return;
+    }
+    // The same time on every rank: every rank takes this path, and the sum in
+    // rank order gives every rank the same force, so the walls stay alike.
+    std::vector<Vec3> forces = wallForces();
+    if (decomposition_) {
+        std::vector<double> local;
+        for (const Vec3& f : forces) local.insert(local.end(), {f.x(), f.y(), f.z()});
+        const std::vector<double> sum = sumOverRanksInRankOrder(decomposition_->communicator(), local);
+        for (std::size_t w = 0; w < forces.size(); ++w) forces[w] = Vec3(sum[3 * w], sum[3 * w + 1], sum[3 * w + 2]);
+    }
+    for (std::size_t w = 0; w < walls_.size(); ++w) {
+        WallMotion& motion = walls_[w].motion;
+        if (!motion.hasLoad()) continue;
+        const Vec3& d = motion.load().direction;
+        motion.advanceLoad(time_, settings_.timeStep, forces[w].dot(d), settings_.gravity.dot(d));
+    }
+}
+
 void Simulation::step(long steps) {
     const double dt = settings_.timeStep;
     // Within one call the closing half kick of a step and the opening half kick
@@ -749,6 +773,7 @@ void Simulation::step(long steps) {
         }
         if (rebuild) updatePairList();
         computeForces(fused);  // a drift (this step's or the last one's) came first
+        advanceWallLoads();
         drifted = s + 1 < steps;
         if (drifted)
             drift(true);  // with the next step's list test and force reset

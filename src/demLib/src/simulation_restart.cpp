@@ -218,6 +218,14 @@ void Simulation::writeRestart(const std::string& path) const {
                 }
                 f.sealAttributes();  // every dataset below carries its own checksum
                 writeRestartDatasets(f, d);
+                if (std::any_of(walls_.begin(), walls_.end(), [](const Wall& w) { return w.motion.hasLoad(); })) {
+                    // Where each wall under load is: its position follows the forces, not the clock.
+                    std::vector<double> loads;
+                    for (const Wall& w : walls_)
+                        loads.insert(loads.end(), {w.motion.loadState().offset, w.motion.loadState().velocity});
+                    f.createGroup("walls");
+                    f.write("walls/loadState", loads);
+                }
                 if (decomposition_) {
                     f.createGroup("decomposition");
                     f.write("decomposition/cuts", decomposition_->slabs().interiorCuts());
@@ -247,6 +255,7 @@ struct LoadedRestart {
     double nextBridgeListingLimit = std::numeric_limits<double>::infinity();
     std::int64_t step = 0, nextId = 0, lostCount = 0, forcesValid = 0, bridgeCount = 0, hasLiquid = 0;
     std::int64_t wallBridgeCount = 0, listBuildCount = 0, decompositionRanks = 0, decompositionAxis = 0;
+    std::vector<double> wallLoads;  // per wall: offset, velocity (WallLoadState); empty in files without loads
     std::vector<double> cuts;
 
     // The scalars as one message (integers below 2^53 pass exactly as doubles).
@@ -257,13 +266,16 @@ struct LoadedRestart {
                               static_cast<double>(lostCount), static_cast<double>(forcesValid),
                               static_cast<double>(bridgeCount), static_cast<double>(hasLiquid),
                               static_cast<double>(wallBridgeCount), static_cast<double>(listBuildCount),
-                              static_cast<double>(decompositionRanks), static_cast<double>(decompositionAxis)};
+                              static_cast<double>(decompositionRanks), static_cast<double>(decompositionAxis),
+                              static_cast<double>(wallLoads.size())};
+        h.insert(h.end(), wallLoads.begin(), wallLoads.end());
         h.insert(h.end(), cuts.begin(), cuts.end());
         return h;
     }
     void setHeader(const std::vector<double>& h) {
-        constexpr std::size_t fixed = 22;
-        if (h.size() < fixed) throw RuntimeError("restart: malformed header message");
+        constexpr std::size_t fixed = 23;
+        if (h.size() < fixed || h.size() < fixed + static_cast<std::size_t>(h[fixed - 1]))
+            throw RuntimeError("restart: malformed header message");
         std::size_t k = 0;
         checked = h[k++] != 0.0;
         for (double* v : {&time, &lostMass, &liquidTotal, &liquidPool, &waterContent, &largestBridge,
@@ -273,7 +285,9 @@ struct LoadedRestart {
         for (std::int64_t* v : {&step, &nextId, &lostCount, &forcesValid, &bridgeCount, &hasLiquid,
                                 &wallBridgeCount, &listBuildCount, &decompositionRanks, &decompositionAxis})
             *v = static_cast<std::int64_t>(h[k++]);
-        cuts.assign(h.begin() + fixed, h.end());
+        const std::size_t loads = static_cast<std::size_t>(h[k++]);
+        wallLoads.assign(h.begin() + fixed, h.begin() + fixed + loads);
+        cuts.assign(h.begin() + fixed + loads, h.end());
     }
 };
 
@@ -350,6 +364,12 @@ LoadedRestart loadRestart(const std::string& path, std::size_t materialCount, st
         r.decompositionRanks = f.intAttribute("decompositionRanks");
         r.decompositionAxis = f.intAttribute("decompositionAxis");
         if (r.decompositionRanks > 1) r.cuts = f.readDoubles("decomposition/cuts");
+    }
+    if (f.exists("walls/loadState")) {
+        r.wallLoads = f.readDoubles("walls/loadState");
+        if (r.wallLoads.size() != 2 * wallCount)
+            throw InputError("restart file '" + path + "': walls/loadState has " + std::to_string(r.wallLoads.size()) +
+                             " values; expected 2 per wall (" + std::to_string(2 * wallCount) + ")");
     }
     d.pairIds = f.readInt64("pairs/ids");
     d.pairShear = f.readVec3("pairs/shear");
@@ -482,6 +502,21 @@ void Simulation::applyRestartScalars(const std::vector<double>& header) {
     pairs_.setRanges(r.listSkin, r.listExtraRange);
     pairs_.setBridgeListing(settings_.bridges, r.listBridgeListingLimit);
     bridgeListingLimit_ = r.nextBridgeListingLimit;
+    for (std::size_t w = 0; w < walls_.size(); ++w) {
+        WallMotion& motion = walls_[w].motion;
+        if (!motion.hasLoad()) continue;
+        if (r.wallLoads.empty()) {
+            // A file without the walls' loads: only a run that had not reached them continues.
+            if (time_ > motion.load().tStart)
+                throw InputError(settings_.source + ": wall '" + walls_[w].name + "' is under load from t = " +
+                                 std::to_string(motion.load().tStart) + " s, and the restart file (t = " +
+                                 std::to_string(time_) + " s) does not say where it is; expected a restart file "
+                                 "written with this wall's load, or one from before it");
+            motion.setLoadState({});
+            continue;
+        }
+        motion.setLoadState({r.wallLoads[2 * w], r.wallLoads[2 * w + 1]});
+    }
 }
 
 

@@ -1,5 +1,6 @@
 #include "demLib/wall_motion.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -84,7 +85,74 @@ void WallMotion::addRotation(double tStart, double tEnd, const Vec3& axisPoint, 
     append(segment);
 }
 
+bool WallMotion::overlapsLoad(double tStart, double tEnd) const {
+    return hasLoad_ && tStart < load_.tEnd() && load_.tStart < tEnd;
+}
+
+void WallMotion::addLoad(const WallLoad& load) {
+    if (hasLoad_) throw InputError("wall motion 'load': the wall has a load already; expected at most one");
+    requireValidInterval("load", load.tStart, load.tRaise);
+    if (!load.direction.allFinite() || !(load.direction.norm() > 0.0))
+        throw InputError("wall motion 'load': direction " + describe(load.direction) +
+                         " is zero or not finite; expected a non-zero vector (the way the wall is lowered)");
+    auto requirePositive = [](const char* what, double value, const char* unit) {
+        if (!(value > 0.0) || !std::isfinite(value)) {
+            std::ostringstream s;
+            s << "wall motion 'load': " << what << " = " << value << "; expected a positive number of " << unit;
+            throw InputError(s.str());
+        }
+    };
+    requirePositive("mass", load.mass, "kg");
+    requirePositive("speed", load.speed, "m/s");
+    requirePositive("stroke", load.stroke, "m");
+    WallLoad checked = load;
+    checked.direction = load.direction / load.direction.norm();
+    for (const MotionSegment& segment : segments_)
+        if (segment.tStart < checked.tEnd() && checked.tStart < segment.tEnd) {
+            std::ostringstream s;
+            s << "wall motion 'load': its window " << checked.tStart << "-" << checked.tEnd()
+              << " s (lowered from tStart, raised from tRaise, back after stroke/speed) overlaps the segment "
+              << segment.tStart << "-" << segment.tEnd << " s; expected a load apart from the segments";
+            throw InputError(s.str());
+        }
+    load_ = checked;
+    hasLoad_ = true;
+    loadState_ = {};
+}
+
+void WallMotion::advanceLoad(double t, double dt, double forceAlong, double gravityAlong) {
+    if (!hasLoad_) return;
+    WallLoadState& s = loadState_;
+    if (t < load_.tStart || t >= load_.tEnd()) {
+        s = {};
+        return;
+    }
+    if (t < load_.tRaise) {
+        // Symplectic Euler (the force is this step's); the hoist holds it back
+        // beyond `speed`, the stop at `stroke`, and it rises no higher than it started.
+        s.velocity = std::min(s.velocity + dt * (gravityAlong + forceAlong / load_.mass), load_.speed);
+        s.offset += dt * s.velocity;
+        if (s.offset > load_.stroke) {
+            s.offset = load_.stroke;
+            s.velocity = std::min(s.velocity, 0.0);
+        } else if (s.offset < 0.0) {
+            s.offset = 0.0;
+            s.velocity = std::max(s.velocity, 0.0);
+        }
+        return;
+    }
+    s.velocity = -load_.speed;
+    s.offset += dt * s.velocity;
+    if (s.offset <= 0.0) s = {};
+}
+
 void WallMotion::append(const MotionSegment& segment) {
+    if (overlapsLoad(segment.tStart, segment.tEnd)) {
+        std::ostringstream s;
+        s << "wall motion: segment " << segment.tStart << "-" << segment.tEnd << " s overlaps the load's window "
+          << load_.tStart << "-" << load_.tEnd() << " s; expected segments apart from the load";
+        throw InputError(s.str());
+    }
     if (!segments_.empty() && segment.tStart < segments_.back().tEnd) {
         std::ostringstream s;
         s << "wall motion: segment starting at t = " << segment.tStart
@@ -105,6 +173,12 @@ void WallMotion::setRemovalTime(double t) {
 }
 
 RigidTransform WallMotion::at(double t) const {
+    RigidTransform pose = prescribedAt(t);
+    if (hasLoad_) pose.translation += loadState_.offset * load_.direction;
+    return pose;
+}
+
+RigidTransform WallMotion::prescribedAt(double t) const {
     // Segments are few (a handful per wall): a linear scan is cheapest.
     RigidTransform pose;
     for (std::size_t i = 0; i < segments_.size(); ++i) {
@@ -121,20 +195,37 @@ RigidTransform WallMotion::at(double t) const {
 }
 
 bool WallMotion::isMovingAt(double t) const {
+    if (hasLoad_ && load_.tStart <= t && t < load_.tEnd()) return true;
     for (const MotionSegment& segment : segments_)
         if (segment.tStart <= t && t < segment.tEnd) return true;
     return false;
 }
 
 double WallMotion::nextChangeAfter(double t) const {
+    double next = std::numeric_limits<double>::infinity();
     for (const MotionSegment& segment : segments_) {
-        if (t < segment.tStart) return segment.tStart;
-        if (t < segment.tEnd) return segment.tEnd;
+        if (t < segment.tStart) {
+            next = segment.tStart;
+            break;
+        }
+        if (t < segment.tEnd) {
+            next = segment.tEnd;
+            break;
+        }
     }
-    return std::numeric_limits<double>::infinity();
+    if (hasLoad_) {
+        if (t < load_.tStart) next = std::min(next, load_.tStart);
+        else if (t < load_.tEnd()) next = std::min(next, load_.tEnd());
+    }
+    return next;
 }
 
 Vec3 WallMotion::velocityAt(const Vec3& worldPoint, double t) const {
+    const Vec3 loaded = hasLoad_ ? Vec3(loadState_.velocity * load_.direction) : Vec3(Vec3::Zero());
+    return loaded + prescribedVelocityAt(worldPoint, t);
+}
+
+Vec3 WallMotion::prescribedVelocityAt(const Vec3& worldPoint, double t) const {
     for (const MotionSegment& segment : segments_) {
         if (t < segment.tStart) {
             break;

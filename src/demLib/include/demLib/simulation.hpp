@@ -228,6 +228,9 @@ private:
                               std::vector<double>& gaps) const;
     // forcesReset: F = m g + F_external and T = 0 are set already (by the drift).
     void computeForces(bool forcesReset);
+    // Moves each wall under load (WallMotion::addLoad) by one step under the
+    // particles' force on it (summed over ranks) and gravity.
+    void advanceWallLoads();
     void requireNoDecomposition(const std::string& what) const;
     // Per list entry: 1 where this rank accounts for the pair (every pair of
     // two owned particles; a pair with a ghost on the rank owning the smaller
