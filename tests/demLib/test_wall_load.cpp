@@ -160,21 +160,24 @@ TEST(WallLoad, StampRestsOnASphereUnderItsWeight) {
     // about speed / omega, 0.4 um: the sphere's damping hardly slows a stamp
     // 190 times heavier).
     s.sim.step(400000);  // to 0.8 s
-    double sum = 0.0, force = 0.0;
+    double sum = 0.0, force = 0.0, floor = 0.0;
     const int samples = 100;
     for (int k = 0; k < samples; ++k) {
         s.sim.step(500);
         sum += s.stampHeight();
         force += s.sim.wallForces()[1].z();
+        floor -= s.sim.wallForces()[0].z();
     }
     const double height = sum / samples;
     const double weight = StampOnSphere::stampMass * g;
-    std::printf("stamp at %.4f um above the floor, expected %.4f um (Hertz); its weight %.5f N, force on it %.5f N\n",
-                height * 1e6, expected * 1e6, weight, force / samples);
+    std::printf("stamp at %.4f um above the floor, expected %.4f um (Hertz); its weight %.5f N, force on it %.5f N, "
+                "the floor carries %.7f N (stamp and sphere: %.7f N)\n",
+                height * 1e6, expected * 1e6, weight, force / samples, floor / samples, weight + sphereMass * g);
     // 1 % of the two overlaps is 0.6 um.  Without its weight it would stand
     // 31 um higher.
     EXPECT_NEAR(height, expected, 0.01 * (2 * StampOnSphere::radius - expected));
     EXPECT_NEAR(force / samples, weight, 0.01 * weight);
+    EXPECT_NEAR(floor / samples, weight + sphereMass * g, 0.01 * weight);
     // Raised at 1.0 s at 0.2 mm/s: at 1.1 s 20 um higher than at rest.
     s.sim.step(100000);  // from 0.9 s to 1.1 s
     EXPECT_NEAR(s.stampHeight() - height, 2e-5, 1e-6);
