@@ -94,9 +94,10 @@ def main(name, case):
             else:
                 check(f"stamp held {stamp['depth_m'] * 1e3:g} mm in: pressed by the powder ({min(pressed):.2f}-"
                       f"{max(pressed):.2f} N)", held and min(pressed) > 10 * weight)
-            # (While the stamp presses, the walls' forces alternate by about +-0.14 N from step to
-            # step, and the log samples the same phase: 2.5 % of a 1 kg stamp's force allowed; the
-            # die wall's share alone is about 30 %.  docs/own-die.md, "Limits".)
+            # (While the stamp presses, CDT's rolling torque makes the walls' friction forces
+            # alternate by about +-0.14 N from step to step, and the log samples the same phase:
+            # 2.5 % of a 1 kg stamp's force allowed; the die wall's share alone is about 30 %.
+            # docs/own-die.md, "Limits".)
             check(f"stamp: balanced by floors + die wall - the powder's weight ({weight:.3f} N) to {residual:.3f} N "
                   f"(2.5 % of its force allowed)", held and residual <= 0.025 * mean_force)
             walls = -sum(f(r, "dieWalls") for r in held) / sum(pressed)
