@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "decomposition_cases.hpp"
+#include "sand_without_gravity.hpp"
 #include "demLib/communicator.hpp"
 #include "demLib/error.hpp"
 #include "demLib/ghost_exchange.hpp"
@@ -126,22 +127,19 @@ struct StampOnSphere {
     static constexpr double radius = 1e-3, stampMass = 0.002, speed = 2e-4, gap = 2e-5;
     dem::Simulation sim;
     StampOnSphere() : sim(make()) { sim.insert({{Vec3(0, 0, radius), radius}}, 0, Vec3::Zero()); }
+    static dem::SimulationSettings settings() {
+        dem::SimulationSettings s;
+        s.timeStep = 2e-6;
+        s.gravity = Vec3(0, 0, -9.81);
+        return s;
+    }
     static dem::Simulation make() {
-        const std::vector<dem::Material> materials{{"sand", 5e6, 0.3, 2500.0}};
-        dem::InteractionTable table(1);
-        dem::PairCoefficients k;
-        k.restitution = 0.5;
-        k.friction = 0.5;
-        table.set(materials, 0, 0, k);
-        dem::SimulationSettings settings;
-        settings.timeStep = 2e-6;
-        settings.gravity = Vec3(0, 0, -9.81);
         dem::WallMotion lowered;
         lowered.addLoad(stampLoad(0.0, 1.0, stampMass, speed, 5e-4));
         std::vector<dem::Wall> walls{
             {"floor", dem::PlaneWall(Vec3::Zero(), Vec3::UnitZ()), dem::WallMotion(), 0},
             {"stamp", dem::PlaneWall(Vec3(0, 0, 2 * radius + gap), -Vec3::UnitZ()), lowered, 0}};
-        return dem::Simulation(settings, materials, table, std::move(walls));
+        return sandSimulation(std::move(walls), settings());
     }
     static double hertzOverlap(double force) {
         const double youngEff = 5e6 / (2.0 * (1.0 - 0.3 * 0.3));  // sphere and wall of the same material
@@ -209,18 +207,9 @@ TEST(WallLoad, RestartWithoutTheLoadsStateIsRefusedOnceTheLoadStarted) {
         (std::filesystem::temp_directory_path() / ("wall_load_old_" + std::to_string(::getpid()) + ".h5")).string();
     // A run whose stamp rests (no load) writes a file without walls/loadState.
     auto unloaded = [] {
-        dem::Simulation sim = StampOnSphere::make();
-        std::vector<dem::Wall> walls = sim.walls();
+        std::vector<dem::Wall> walls = StampOnSphere::make().walls();
         walls[1].motion = dem::WallMotion();
-        const std::vector<dem::Material> materials{{"sand", 5e6, 0.3, 2500.0}};
-        dem::InteractionTable table(1);
-        dem::PairCoefficients k;
-        k.restitution = 0.5;
-        k.friction = 0.5;
-        table.set(materials, 0, 0, k);
-        dem::SimulationSettings settings;
-        settings.timeStep = 2e-6;
-        return dem::Simulation(settings, materials, table, walls);
+        return sandSimulation(walls, StampOnSphere::settings());
     }();
     unloaded.insert({{Vec3(0, 0, StampOnSphere::radius), StampOnSphere::radius}}, 0, Vec3::Zero());
     unloaded.step(100);
