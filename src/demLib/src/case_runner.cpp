@@ -555,6 +555,7 @@ void CaseRunner::writeSummaryLine() {
     const Communicator& comm = options_.communicator;
     // Every value of the run (collectives with a decomposition), then rank 0 writes.
     const RunTotals totals = s.totalsOverRanks();
+    simulation_->restartWallForceMeans();  // the next line's wall forces: the mean over its interval
     const LiquidState l = s.liquidOverRanks();
     const bool wet = setup_.waterContent > 0.0;
     const double inBridges = wet ? s.liquidInBridges() : 0.0;

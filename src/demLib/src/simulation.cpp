@@ -373,6 +373,19 @@ std::vector<Vec3> Simulation::wallForces() const {
     return sum;
 }
 
+void Simulation::restartWallForceMeans() {
+    wallForceSum_.assign(walls_.size(), Vec3::Zero());
+    wallForceSteps_ = 0;
+}
+
+void Simulation::accumulateWallForces() {
+    if (wallForceSum_.size() != walls_.size()) restartWallForceMeans();
+    const std::size_t owned = ownedCount();
+    for (const WallContactRecord& r : wallContacts_.records())
+        if (static_cast<std::size_t>(r.particle) < owned) wallForceSum_[r.wall] -= r.force;
+    ++wallForceSteps_;
+}
+
 RunTotals Simulation::totalsOverRanks() const {
     RunTotals t;
     const std::size_t owned = ownedCount();
@@ -382,7 +395,12 @@ RunTotals Simulation::totalsOverRanks() const {
     t.wallContacts = last_.contacts.wallContacts;
     t.lost = lost_;
     t.lostMass = lostMass_;
-    t.wallForces = wallForces();
+    if (wallForceSteps_ > 0) {
+        t.wallForces = wallForceSum_;
+        for (Vec3& f : t.wallForces) f /= static_cast<double>(wallForceSteps_);
+    } else {
+        t.wallForces = wallForces();
+    }
     if (!decomposition_) return t;
     // The kernel counted what it computed: a pair across a slab face on both
     // of its ranks, and the ghosts' wall contacts.  Those are taken out here
@@ -774,6 +792,7 @@ void Simulation::step(long steps) {
         if (rebuild) updatePairList();
         computeForces(fused);  // a drift (this step's or the last one's) came first
         advanceWallLoads();
+        accumulateWallForces();
         drifted = s + 1 < steps;
         if (drifted)
             drift(true);  // with the next step's list test and force reset

@@ -101,7 +101,10 @@ struct RunTotals {
     std::size_t wallContacts = 0;   // particle-wall contacts in contact then
     std::size_t lost = 0;           // particles lost so far ...
     double lostMass = 0.0;          // ... and their mass [kg]
-    std::vector<Vec3> wallForces;   // force of the particles on each wall [N]
+    // Force of the particles on each wall [N]: the mean over the steps since
+    // Simulation::restartWallForceMeans() (the impulse they gave the wall over
+    // that time / the time), or the last step's when no step was made since.
+    std::vector<Vec3> wallForces;
     // Mean number of touching contacts per particle.
     double coordinationNumber() const { return particles == 0 ? 0.0 : 2.0 * touchingPairs / particles; }
 };
@@ -182,6 +185,11 @@ public:
     // liquid bridges; walls in the order of walls()) [N].  With a
     // decomposition: of this rank's particles.
     std::vector<Vec3> wallForces() const;
+    // Starts the means of the walls' forces over the steps to come (RunTotals::
+    // wallForces): a front end calls it after each summary line.  A force that
+    // alternates from step to step (CDT's rolling torque in a bed at rest) is
+    // then logged as its mean, not as the value at one phase.
+    void restartWallForceMeans();
 
     // The run's totals now.  Collective with a decomposition (sums in rank
     // order); without one the values of this simulation.
@@ -231,6 +239,9 @@ private:
     // Moves each wall under load (WallMotion::addLoad) by one step under the
     // particles' force on it (summed over ranks) and gravity.
     void advanceWallLoads();
+    // Adds this step's force of this rank's particles on each wall to the sums
+    // behind RunTotals::wallForces.
+    void accumulateWallForces();
     void requireNoDecomposition(const std::string& what) const;
     // Per list entry: 1 where this rank accounts for the pair (every pair of
     // two owned particles; a pair with a ghost on the rank owning the smaller
@@ -277,6 +288,8 @@ private:
     double bridgeListingLimit_ = std::numeric_limits<double>::infinity();
     long bridgeRelists_ = 0;
     StepStatistics last_;
+    std::vector<Vec3> wallForceSum_;  // sum over the steps since restartWallForceMeans()
+    long wallForceSteps_ = 0;
     std::shared_ptr<GhostExchange> decomposition_;  // null: serial run
 };
 
