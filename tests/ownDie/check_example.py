@@ -95,11 +95,11 @@ def main(name, case):
                 check(f"stamp held {stamp['depth_m'] * 1e3:g} mm in: pressed by the powder ({min(pressed):.2f}-"
                       f"{max(pressed):.2f} N)", held and min(pressed) > 10 * weight)
             # (While the stamp presses, CDT's rolling torque makes the walls' friction forces
-            # alternate by about +-0.14 N from step to step, and the log samples the same phase:
-            # 2.5 % of a 1 kg stamp's force allowed; the die wall's share alone is about 30 %.
+            # alternate by about +-0.14 N from step to step; summary.csv logs each wall's mean
+            # force over the log interval, which balances to about 0.001 N: 1 % allowed.
             # docs/own-die.md, "Limits".)
             check(f"stamp: balanced by floors + die wall - the powder's weight ({weight:.3f} N) to {residual:.3f} N "
-                  f"(2.5 % of its force allowed)", held and residual <= 0.025 * mean_force)
+                  f"(1 % of its force allowed)", held and residual <= 0.01 * mean_force)
             walls = -sum(f(r, "dieWalls") for r in held) / sum(pressed)
             check(f"stamp: the die wall carries part of it by friction ({walls:.2f}), the floors the rest",
                   0.05 < walls < 0.95)
