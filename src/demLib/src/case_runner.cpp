@@ -88,9 +88,10 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
     simulation_ = makeSimulation(setup_);
     const Communicator& comm = options_.communicator;
     if (!comm.isSerial()) {
-        // First slabs: equal widths along the longest side of the domain box
-        // (or of the insertion regions); the load balance re-cuts them by
-        // particle count at the first list build and whenever the powder moves.
+        // First slabs: equal widths along loadBalance's axis, by default the
+        // longest side of the domain box (or of the insertion regions); the
+        // load balance re-cuts them by particle count at the first list build
+        // and whenever the powder moves.
         Vec3 low = Vec3::Constant(std::numeric_limits<double>::infinity()), high = -low;
         if (setup_.settings.domain) {
             low = setup_.settings.domain->min;
@@ -109,9 +110,12 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
             low = Vec3::Constant(-1.0);
             high = Vec3::Constant(1.0);
         }
-        int axis = 0;
-        for (int d = 1; d < 3; ++d)
-            if (high[d] - low[d] > high[axis] - low[axis]) axis = d;
+        int axis = setup_.settings.decompositionAxis;
+        if (axis < 0) {
+            axis = 0;
+            for (int d = 1; d < 3; ++d)
+                if (high[d] - low[d] > high[axis] - low[axis]) axis = d;
+        }
         simulation_->setDecomposition(std::make_shared<GhostExchange>(
             comm, SlabDecomposition::uniform(comm.size(), axis, low[axis], high[axis]),
             setup_.settings.loadBalanceThreshold));
@@ -148,6 +152,13 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
         log_ << "Continuing from restart file " << restart << " at t = " << startTime_ << " s, step "
              << simulation_->stepCount() << ", " << particleCount() << " particles"
              << (comm.isSerial() ? std::string() : " on " + std::to_string(comm.size()) + " ranks") << "\n";
+    }
+    if (const GhostExchange* d = simulation_->decomposition(); d && !comm.isSerial()) {
+        log_ << "DEM over " << comm.size() << " ranks: slabs across " << "xyz"[d->slabs().axis()] << " ("
+             << (setup_.settings.decompositionAxis < 0 ? "the domain's longest side" : "keyword 'loadBalance/axis'")
+             << "), cuts at";
+        for (double c : d->slabs().interiorCuts()) log_ << " " << c;
+        log_ << " m\n";
     }
     checkStepCount();
     for (const InsertionSpec& spec : setup_.insertions)

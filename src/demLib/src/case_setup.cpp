@@ -457,6 +457,10 @@ CaseSetup readCaseSetup(const Dictionary& root, const std::string& caseDir) {
                                       ? LoadBalanceWeight::Work
                                       : LoadBalanceWeight::Particles;
         if (balance.has("threshold")) s.loadBalanceThreshold = balance.getInRange("threshold", 1.0, 1e3);
+        if (balance.has("axis")) {
+            const std::string axis = balance.getChoice("axis", {"auto", "x", "y", "z"});
+            s.decompositionAxis = axis == "auto" ? -1 : axis[0] - 'x';
+        }
     }
     if (sim.has("domain")) {
         const Dictionary& box = sim.subDict("domain");

@@ -537,11 +537,12 @@ bool Simulation::readRestartDecomposed(const std::string& path) {
             LoadedRestart loaded = loadRestart(path, materials_.size(), walls_.size(), settings_.timeStep,
                                                settings_.forces.wallBridges);
             const RestartData& d = loaded.data;
-            // Written on as many ranks: its slabs give every particle back to
-            // its rank, in its order (a bitwise continuation).  Otherwise the
-            // slabs set up here, re-cut by the load balance at the next build.
+            // Written on as many ranks, cut across the same axis: its slabs
+            // give every particle back to its rank, in its order (a bitwise
+            // continuation).  Otherwise the slabs set up here, re-cut by the
+            // load balance at the next build.
             SlabDecomposition slabs = decomposition_->slabs();
-            if (loaded.decompositionRanks == ranks && ranks > 1)
+            if (loaded.decompositionRanks == ranks && ranks > 1 && loaded.decompositionAxis == slabs.axis())
                 slabs = SlabDecomposition(ranks, static_cast<int>(loaded.decompositionAxis), loaded.cuts);
             loaded.cuts = slabs.interiorCuts();
             loaded.decompositionAxis = slabs.axis();
