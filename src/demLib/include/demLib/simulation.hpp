@@ -74,8 +74,8 @@ struct SimulationSettings {
     LoadBalanceWeight loadBalanceWeight = LoadBalanceWeight::Particles;
     double loadBalanceThreshold = GhostExchange::defaultRebalanceThreshold;
     // The axis the slabs are cut across (0 = x, 1 = y, 2 = z); -1: the longest
-    // side of the domain box.  A die filling cut across the shoe's motion gives
-    // every rank a share of the shoe's powder and of the die's.
+    // side of the domain box (docs/performance.md: the die filling cut across
+    // the shoe's motion ran no faster on 2 ranks than cut along it).
     int decompositionAxis = -1;
     // Name of the input the settings came from, for error messages.
     std::string source = "demLib";
