@@ -18,7 +18,8 @@ Foam::diefill::voidFractionModel::voidFractionModel
 :
     mesh_(mesh),
     coeffs_(coeffs),
-    localBounds_(mesh.points())
+    localBounds_(mesh.points()),
+    locator_(mesh)
 {}
 
 
@@ -58,7 +59,7 @@ Foam::label Foam::diefill::voidFractionModel::findCell
             }
         }
     }
-    return mesh_.findCell(p);
+    return locator_.findCell(p);
 }
 
 
@@ -85,8 +86,13 @@ Foam::diefill::voidFractionModel::New
 
     Info<< "    void fraction model: " << name << endl;
 
-    return autoPtr<voidFractionModel>
+    autoPtr<voidFractionModel> model
     (
         cstrIter()(mesh, modelCoeffs(couplingDict, name))
     );
+    Info<< "    cell search: hint, its face neighbours, then "
+        << model->locator_.nBins() << " bins of "
+        << model->locator_.cellsPerBin() << " cells on average"
+        << (Pstream::parRun() ? " (master's part)" : "") << endl;
+    return model;
 }
