@@ -25,6 +25,8 @@
 #include <iomanip>
 #include <iostream>
 #include <sstream>
+#include <tuple>
+#include <type_traits>
 #include <unordered_map>
 
 // Defined in demLib (src/demLib/src/version.cpp): the version of the library
@@ -52,7 +54,7 @@ void Foam::diefill::demCoupling::checkLibraryVersion()
 
 
 template<class Type>
-Foam::Field<Type> Foam::diefill::demCoupling::averageToParticles
+Foam::Field<Type> Foam::diefill::demCoupling::localAverage
 (
     const UList<Type>& cellValues
 ) const
@@ -65,33 +67,62 @@ Foam::Field<Type> Foam::diefill::demCoupling::averageToParticles
             result[i] += weights_[i][k]*cellValues[cells_[i][k]];
         }
     }
-    if (decomposed_)
-    {
-        // Each visitor's share back to its owner, summed in rank order
-        const label width = pTraits<Type>::nComponents;
-        std::vector<double> shares(result.size()*width);
-        forAll(result, v)
-        {
-            for (label c = 0; c < width; ++c)
-            {
-                shares[v*width + c] = component(result[v], c);
-            }
-        }
-        const std::vector<double> sums = routing_->sumToOwners(shares, width);
-        Field<Type> owned(nOwned(), Zero);
-        forAll(owned, i)
-        {
-            for (label c = 0; c < width; ++c)
-            {
-                setComponent(owned[i], c) = sums[i*width + c];
-            }
-        }
-        return owned;
-    }
-    // Master sums and sends back: every rank gets the same bits.
-    Pstream::listCombineGather(result, plusEqOp<Type>());
-    Pstream::listCombineScatter(result);
     return result;
+}
+
+
+template<class... Types>
+std::tuple<Foam::Field<Types>...> Foam::diefill::demCoupling::averageToParticles
+(
+    const UList<Types>&... cellValues
+) const
+{
+    // Serially each particle's cells are all here: the sums are complete
+    std::tuple<Field<Types>...> local(localAverage(cellValues)...);
+    if (!decomposed_)
+    {
+        return local;
+    }
+
+    // Decomposed: each visitor's shares of every field back to its owner in
+    // one message per rank, summed in rank order
+    const label width = (label(pTraits<Types>::nComponents) + ...);
+    const label nVisitors = cells_.size();
+    std::vector<double> shares(std::size_t(nVisitors)*width);
+    label offset = 0;
+    auto pack = [&](const auto& field)
+    {
+        using Type = typename std::decay_t<decltype(field)>::value_type;
+        for (label v = 0; v < nVisitors; ++v)
+        {
+            for (direction c = 0; c < pTraits<Type>::nComponents; ++c)
+            {
+                shares[std::size_t(v)*width + offset + c] = component(field[v], c);
+            }
+        }
+        offset += pTraits<Type>::nComponents;
+    };
+    std::apply([&](const auto&... fields) { (pack(fields), ...); }, local);
+
+    const std::vector<double> sums = routing_->sumToOwners(shares, width);
+    const label n = nOwned();
+    std::tuple<Field<Types>...> owned;
+    offset = 0;
+    auto unpack = [&](auto& field)
+    {
+        using Type = typename std::decay_t<decltype(field)>::value_type;
+        field.setSize(n);
+        for (label i = 0; i < n; ++i)
+        {
+            for (direction c = 0; c < pTraits<Type>::nComponents; ++c)
+            {
+                setComponent(field[i], c) = sums[std::size_t(i)*width + offset + c];
+            }
+        }
+        offset += pTraits<Type>::nComponents;
+    };
+    std::apply([&](auto&... fields) { (unpack(fields), ...); }, owned);
+    return owned;
 }
 
 
@@ -160,6 +191,32 @@ Foam::label Foam::diefill::demCoupling::demStepsPerFluidStep() const
     checkTimeSteps(demDt);
     return label(std::round(mesh_.time().deltaTValue()/demDt));
 }
+
+
+namespace
+{
+
+// The log lines' figures of a coupling step in one reduction over the ranks:
+// the sum of each of the first N - nMin entries, the least of the last nMin
+template<unsigned N, unsigned nMin>
+struct sumThenMinOp
+{
+    Foam::FixedList<Foam::scalar, N> operator()
+    (
+        const Foam::FixedList<Foam::scalar, N>& a,
+        const Foam::FixedList<Foam::scalar, N>& b
+    ) const
+    {
+        Foam::FixedList<Foam::scalar, N> result;
+        for (unsigned k = 0; k < N; ++k)
+        {
+            result[k] = k + nMin < N ? a[k] + b[k] : Foam::min(a[k], b[k]);
+        }
+        return result;
+    }
+};
+
+} // End anonymous namespace
 
 
 // * * * * * * * * * * * * * * * * Constructors  * * * * * * * * * * * * * * //
@@ -863,19 +920,33 @@ void Foam::diefill::demCoupling::updateVoidFraction()
             if (ownerTotal[i] <= 0) ++nLost_;
             else particleVolume += 4.0/3.0*constant::mathematical::pi*pow3(particles.radius[i]);
         }
-        reduce(nLost_, sumOp<label>());
-        reduce(particleVolume, sumOp<scalar>());
     }
 
-    // Volume conservation check: what the cells hold vs the particles
-    const scalar cellVolume = gSum(solidFraction*mesh_.V());
-    reduce(nClamped, sumOp<label>());
+    // The log line, with the volume conservation check (what the cells hold
+    // vs the particles); decomposed, its figures in one reduction
+    const scalarField& V = mesh_.V();
+    FixedList<scalar, 8> figures
+    ({
+        scalar(nOwned()),
+        scalar(nLost_),
+        particleVolume,
+        sum(solidFraction*V),
+        sum(alpha*V),
+        sum(V),
+        scalar(nClamped),
+        min(alpha)
+    });
+    if (decomposed_)
+    {
+        reduce(figures, sumThenMinOp<8, 1>());
+        nLost_ = label(figures[1]);
+    }
 
-    Info<< "Coupling: " << nParticles() << " particles (" << nLost_
-        << " outside the mesh), solid volume: particles " << particleVolume
-        << " m3, cells " << cellVolume << " m3; void fraction min "
-        << gMin(alpha) << " mean " << gSum(alpha*mesh_.V())/gSum(mesh_.V())
-        << ", " << nClamped << " cell(s) clamped to alphaMin ("
+    Info<< "Coupling: " << label(figures[0]) << " particles (" << nLost_
+        << " outside the mesh), solid volume: particles " << figures[2]
+        << " m3, cells " << figures[3] << " m3; void fraction min "
+        << figures[7] << " mean " << figures[4]/figures[5]
+        << ", " << label(figures[6]) << " cell(s) clamped to alphaMin ("
         << double(started.elapsed()) << " s)" << endl;
 }
 
@@ -888,8 +959,8 @@ void Foam::diefill::demCoupling::updateExchange
 {
     const label n = nOwned();
 
-    const vectorField Uf(averageToParticles<vector>(U_.primitiveField()));
-    const scalarField alphaP(averageToParticles<scalar>(alpha_.primitiveField()));
+    const auto [Uf, alphaP] =
+        averageToParticles(U_.primitiveField(), alpha_.primitiveField());
 
     K_.setSize(n);
     scalarField& KspIn = Ksp.primitiveFieldRef();
@@ -958,10 +1029,13 @@ void Foam::diefill::demCoupling::updateParticleForces
     auto& particles = runner_->simulation().particles();
     const label n = nOwned();
 
-    const vectorField Uf(averageToParticles<vector>(U_.primitiveField()));
-    const scalarField alphaP(averageToParticles<scalar>(alpha_.primitiveField()));
     const volVectorField gradP(rho_*fvc::grad(p_));
-    const vectorField gradPP(averageToParticles<vector>(gradP.primitiveField()));
+    const auto [Uf, alphaP, gradPP] = averageToParticles
+    (
+        U_.primitiveField(),
+        alpha_.primitiveField(),
+        gradP.primitiveField()
+    );
 
     vector dragOnParticles(Zero);
     vector explicitOnParticles(Zero);
@@ -987,23 +1061,36 @@ void Foam::diefill::demCoupling::updateParticleForces
         const auto& v = particles.velocity[i];
         meanVelocity += vector(v.x(), v.y(), v.z());
     }
-    label total = n;
+    // What the air lost through its exchange terms, from the fields alone
+    const vector lostInCells =
+        sum(mesh_.V()*(Ksp.primitiveField()*U_.primitiveField() - KUp.primitiveField()));
+
+    // Decomposed: the log lines' sums in one reduction
+    FixedList<scalar, 13> figures;
+    for (direction c = 0; c < vector::nComponents; ++c)
+    {
+        figures[c] = dragOnParticles[c];
+        figures[3 + c] = explicitOnParticles[c];
+        figures[6 + c] = meanVelocity[c];
+        figures[9 + c] = lostInCells[c];
+    }
+    figures[12] = n;
     if (decomposed_)
     {
-        reduce(dragOnParticles, sumOp<vector>());
-        reduce(explicitOnParticles, sumOp<vector>());
-        reduce(meanVelocity, sumOp<vector>());
-        reduce(total, sumOp<label>());
+        reduce(figures, sumThenMinOp<13, 0>());
+        for (direction c = 0; c < vector::nComponents; ++c)
+        {
+            dragOnParticles[c] = figures[c];
+            explicitOnParticles[c] = figures[3 + c];
+            meanVelocity[c] = figures[6 + c];
+        }
     }
+    const label total = label(figures[12]);
     if (total > 0)
     {
         meanVelocity /= total;
     }
-
-    // What the air lost through its exchange terms, from the fields alone
-    const vector lostByAir =
-        rho_*gSum(mesh_.V()*(Ksp.primitiveField()*U_.primitiveField()
-      - KUp.primitiveField()));
+    const vector lostByAir(rho_*vector(figures[9], figures[10], figures[11]));
 
     Info<< "Coupling: drag on particles " << dragOnParticles
         << " N, momentum lost by the air " << lostByAir

@@ -119,7 +119,14 @@ std::vector<double> Foam::diefill::particleRouting::sumToOwners
         appendDoubles(send[rank], perVisitor.data() + v*width, std::size_t(receivedFrom_[rank])*width);
         v += receivedFrom_[rank];
     }
-    const auto received = comm_.exchange(send);
+    // Each rank knows what comes back: its particles sent there (one round)
+    std::vector<std::size_t> expected(ranks);
+    for (int rank = 0; rank < ranks; ++rank)
+    {
+        expected[rank] = sent_[rank].size()*width*sizeof(double);
+    }
+    const auto received =
+        comm_.exchangeKnownSizesAndAnyTrue(send, expected, false).received;
     std::vector<double> sum(std::size_t(nOwned_)*width, 0.0);
     for (int rank = 0; rank < ranks; ++rank)
     {
@@ -157,7 +164,14 @@ std::vector<double> Foam::diefill::particleRouting::sendToVisitors
             appendDoubles(send[rank], perOwned.data() + std::size_t(i)*width, width);
         }
     }
-    const auto received = comm_.exchange(send);
+    // Each rank knows what comes: its visitors from there (one round)
+    std::vector<std::size_t> expected(ranks);
+    for (int rank = 0; rank < ranks; ++rank)
+    {
+        expected[rank] = std::size_t(receivedFrom_[rank])*width*sizeof(double);
+    }
+    const auto received =
+        comm_.exchangeKnownSizesAndAnyTrue(send, expected, false).received;
     std::vector<double> values;
     values.reserve(centres_.size()*width);
     for (int rank = 0; rank < ranks; ++rank)
