@@ -341,6 +341,64 @@ TEST(ThreadRanks, RestartWrittenOnNRanksContinuesOnM) {
     }
 }
 
+// A restart read on another rank count is cut by particle count over the
+// file's particles before they are handed out, so that a bed at rest does not
+// stay on the ranks the set-up slabs gave it until its next list build (the
+// set-up cut here lies beyond every particle: one rank would own them all).
+// Read on as many ranks as wrote it, the file's own cuts are kept.
+TEST(ThreadRanks, RestartOnAnotherRankCountStartsBalanced) {
+    OneThread one;
+    const Case c = wetGas();
+    const double width = c.xUpper - c.xLower;
+    for (int writers : {0, 2}) {
+        const std::string file = ::testing::TempDir() + "balanced_restart_" + std::to_string(writers) + ".h5";
+        std::vector<double> writtenCuts;
+        auto write = [&](dem::Simulation& sim) {
+            sim.insert(c.particles, 0, Vec3::Zero());
+            setMotionById(sim, c);
+            sim.setWaterContent(c.waterContent);
+            sim.step(60);
+            sim.writeRestart(file);
+        };
+        if (writers == 0) {
+            dem::Simulation sim = c.make();
+            write(sim);
+        } else {
+            dem::Communicator::runThreadGroup(writers, [&](const dem::Communicator& comm) {
+                auto sim = std::make_unique<dem::Simulation>(c.make());
+                sim->setDecomposition(std::make_shared<dem::GhostExchange>(
+                    comm, dem::SlabDecomposition::uniform(comm.size(), 0, c.xLower, c.xUpper)));
+                write(*sim);
+                if (comm.rank() == 0) writtenCuts = sim->decomposition()->slabs().interiorCuts();
+            });
+        }
+        dem::Communicator::runThreadGroup(2, [&](const dem::Communicator& comm) {
+            SCOPED_TRACE("written on " + std::to_string(writers) + " ranks, read on 2");
+            auto sim = std::make_unique<dem::Simulation>(c.make());
+            sim->setDecomposition(std::make_shared<dem::GhostExchange>(
+                comm, dem::SlabDecomposition::uniform(2, 0, c.xUpper + width, c.xUpper + 3 * width)));
+            sim->readRestart(file);
+            const dem::GhostExchange& d = *sim->decomposition();
+            const std::int64_t owned = static_cast<std::int64_t>(sim->ownedCount());
+            const std::int64_t total = comm.sum(owned);
+            const double largest = comm.max(static_cast<double>(owned));
+            if (comm.rank() != 0) return;
+            ASSERT_EQ(total, static_cast<std::int64_t>(c.particles.size()));
+            if (writers == 2) {
+                EXPECT_EQ(d.recutCount(), 0u) << "read on as many ranks: expected the file's cuts";
+                EXPECT_EQ(d.slabs().interiorCuts(), writtenCuts);
+                return;
+            }
+            EXPECT_EQ(d.recutCount(), 1u);
+            EXPECT_EQ(d.lastRecut().maxOwned, total) << "before: the set-up slabs gave one rank every particle";
+            EXPECT_DOUBLE_EQ(d.lastRecut().imbalance, 2.0);
+            EXPECT_LE(largest / (0.5 * static_cast<double>(total)), 1.05);
+            EXPECT_DOUBLE_EQ(d.lastRecut().imbalanceAfter, largest / (0.5 * static_cast<double>(total)));
+        });
+        std::remove(file.c_str());
+    }
+}
+
 // Ranks that are threads of this process: the same collectives as MPI's,
 // for 1 to 4 ranks, many times over (the slots of two phases alternate).
 TEST(ThreadRanks, CollectivesGiveEveryRankTheSameResults) {

@@ -434,7 +434,7 @@ TEST(Rebalance, WeightsDecideTheLoad) {
 // insertion makes the lists build again: weighted by work the slabs are
 // re-cut through the block, by particles they stay.
 void blockAndLine(dem::LoadBalanceWeight weight, const Communicator& c, std::size_t& recuts,
-                  dem::GhostExchange::RebalanceReport& lastRecut, double& ownedMaxOverMean) {
+                  dem::GhostExchange::RebalanceReport& lastRecut, double& ownedMaxOverMean, long stepsBetween = 0) {
     const double r = 5e-4;
     dem::SimulationSettings s;
     s.loadBalanceWeight = weight;
@@ -451,6 +451,7 @@ void blockAndLine(dem::LoadBalanceWeight weight, const Communicator& c, std::siz
     sim.insert(spheres, 0, Vec3::Zero());
     sim.step(1);
     EXPECT_EQ(sim.decomposition()->recutCount(), 1u);
+    sim.step(stepsBetween);
     sim.insert({{Vec3(0.5, -0.05, 0.0), r}}, 0, Vec3::Zero());
     sim.step(1);
     recuts = sim.decomposition()->recutCount();
@@ -480,6 +481,24 @@ TEST(Rebalance, SimulationBalancesWorkWhenAsked) {
         EXPECT_EQ(recuts, 1u) << "equal counts: no second re-cut";
         EXPECT_FALSE(report.weighted);
         EXPECT_LE(owned, 1.01);
+    });
+}
+
+// By busy time: the first build (nothing timed yet) balances counts, as by
+// work; after 1500 steps the block's rank has been busier than the line's
+// (its pairs), and the insertion's build re-cuts through the block.
+TEST(Rebalance, SimulationBalancesBusyTimeWhenAsked) {
+    Communicator::runThreadGroup(2, [](const Communicator& c) {
+        std::size_t recuts = 0;
+        dem::GhostExchange::RebalanceReport report;
+        double owned = 0.0;
+        blockAndLine(dem::LoadBalanceWeight::Time, c, recuts, report, owned, 1500);
+        EXPECT_GE(recuts, 2u);
+        EXPECT_TRUE(report.weighted);
+        EXPECT_GT(report.imbalance, 1.1) << "busy time before: the block's rank the busier";
+        ASSERT_EQ(report.cuts.size(), 1u);
+        EXPECT_LT(report.cuts[0], 0.02) << "cut through the block";
+        EXPECT_GT(owned, 1.1) << "equal busy time is not equal counts here";
     });
 }
 

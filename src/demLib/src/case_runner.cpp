@@ -152,6 +152,7 @@ CaseRunner::CaseRunner(CaseSetup setup, const RunOptions& options, std::ostream&
         log_ << "Continuing from restart file " << restart << " at t = " << startTime_ << " s, step "
              << simulation_->stepCount() << ", " << particleCount() << " particles"
              << (comm.isSerial() ? std::string() : " on " + std::to_string(comm.size()) + " ranks") << "\n";
+        logRecuts();  // cut by count at the restart when read on another rank count
     }
     if (const GhostExchange* d = simulation_->decomposition(); d && !comm.isSerial()) {
         log_ << "DEM over " << comm.size() << " ranks: slabs across " << "xyz"[d->slabs().axis()] << " ("
@@ -766,8 +767,10 @@ void CaseRunner::logRecuts() {
          << " = " << static_cast<double>(r.maxOwned) / r.meanOwned << " before, max/mean "
          << r.imbalanceAfter << " after";
     if (r.weighted)
-        log_ << "; work (1 + listed pairs + wall contacts per particle) max/mean " << r.imbalance << " before, "
-             << r.loadImbalanceAfter << " after";
+        log_ << (setup_.settings.loadBalanceWeight == LoadBalanceWeight::Time
+                     ? "; busy time (step() less its collectives, per rank since the last check) max/mean "
+                     : "; work (1 + listed pairs + wall contacts per particle) max/mean ")
+             << r.imbalance << " before, " << r.loadImbalanceAfter << " after";
     log_ << "; cuts along " << "xyz"[d->slabs().axis()] << " now at";
     for (double c : r.cuts) log_ << " " << c;
     log_ << " m" << std::endl;

@@ -452,10 +452,12 @@ CaseSetup readCaseSetup(const Dictionary& root, const std::string& caseDir) {
         s.maxCapillaryClusterFraction = sim.getInRange("maxCapillaryClusterFraction", 1e-3, 1.0);
     if (sim.has("loadBalance")) {
         const Dictionary& balance = sim.subDict("loadBalance");
-        if (balance.has("weight"))
-            s.loadBalanceWeight = balance.getChoice("weight", {"particles", "work"}) == "work"
-                                      ? LoadBalanceWeight::Work
-                                      : LoadBalanceWeight::Particles;
+        if (balance.has("weight")) {
+            const std::string weight = balance.getChoice("weight", {"particles", "work", "time"});
+            s.loadBalanceWeight = weight == "work"   ? LoadBalanceWeight::Work
+                                  : weight == "time" ? LoadBalanceWeight::Time
+                                                     : LoadBalanceWeight::Particles;
+        }
         if (balance.has("threshold")) s.loadBalanceThreshold = balance.getInRange("threshold", 1.0, 1e3);
         if (balance.has("axis")) {
             const std::string axis = balance.getChoice("axis", {"auto", "x", "y", "z"});

@@ -147,6 +147,38 @@ GhostExchange::RebalanceReport GhostExchange::rebalance(const ParticleStore& p, 
     return report;
 }
 
+GhostExchange::RebalanceReport GhostExchange::balanceUndistributed(const std::vector<Vec3>& positions) {
+    if (ghostCount_ != 0) throw RuntimeError("demLib ghost exchange: balanceUndistributed() called with ghosts present");
+    RebalanceReport report;
+    const int ranks = communicator_.size();
+    if (balancingEnabled() && ranks > 1) {
+        // The counts the current slabs would give, summed over the ranks.
+        std::vector<double> counts(ranks, 0.0);
+        for (const Vec3& x : positions) counts[slabs_.ownerOf(x, 0)] += 1.0;
+        counts = sumOverRanksInRankOrder(communicator_, counts);
+        double largest = 0.0, total = 0.0;
+        for (double c : counts) {
+            largest = std::max(largest, c);
+            total += c;
+        }
+        report.maxOwned = static_cast<std::int64_t>(largest);
+        report.meanOwned = total / ranks;
+        report.imbalance = total > 0.0 ? largest / report.meanOwned : 0.0;
+        report.recut = total > 0.0 && report.imbalance > rebalanceThreshold_;
+        if (report.recut) {
+            const int axis = slabs_.axis();
+            std::vector<double> coordinates(positions.size());
+            for (std::size_t i = 0; i < positions.size(); ++i) coordinates[i] = positions[i][axis];
+            setSlabs(SlabDecomposition::balanced(communicator_, axis, coordinates));
+            ++recuts_;
+        }
+    }
+    report.cuts = slabs_.interiorCuts();
+    lastRebalance_ = report;
+    if (report.recut) lastRecut_ = report;
+    return report;
+}
+
 void GhostExchange::dropGhosts(ParticleStore& p, ParticleParticleNeighborList& pairs, ParticleWallContacts& walls) {
     const std::size_t owned = ownedCount(p);
     const auto& offsets = pairs.offsets();

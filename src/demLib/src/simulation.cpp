@@ -1,6 +1,7 @@
 #include "demLib/simulation.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -496,13 +497,33 @@ void Simulation::updatePairList() {
         // their owners.
         // The work is read from the lists before dropGhosts empties them; the
         // owned particles keep their order.
-        const bool byWork =
-            settings_.loadBalanceWeight == LoadBalanceWeight::Work && decomposition_->balancingEnabled();
-        const std::vector<double> work = byWork ? ownedWork() : std::vector<double>();
+        // Timed: once a rank has been busy long enough to time (the same
+        // decision on all ranks), by its busy time; until the first such
+        // check by counts (the powder may start on one rank); between two
+        // such checks not at all (counts would undo what time balanced).
+        enum class Check { Counts, Weights, None } check = Check::Counts;
+        std::vector<double> weights;
+        if (decomposition_->balancingEnabled() && settings_.loadBalanceWeight == LoadBalanceWeight::Work) {
+            check = Check::Weights;
+            weights = ownedWork();
+        } else if (decomposition_->balancingEnabled() && settings_.loadBalanceWeight == LoadBalanceWeight::Time) {
+            const double now = busySecondsSoFar();
+            const double busy = std::max(now - busySecondsAtCheck_, 0.0);
+            if (decomposition_->communicator().max(busy) >= minimumTimedSeconds) {
+                check = Check::Weights;
+                const std::size_t owned = ownedCount();
+                // A rank's busy time shared by its particles; one that owns none weighs nothing.
+                weights.assign(owned, owned > 0 ? busy / static_cast<double>(owned) : 0.0);
+                busySecondsAtCheck_ = now;
+                timedCheckDone_ = true;
+            } else if (timedCheckDone_) {
+                check = Check::None;
+            }
+        }
         decomposition_->dropGhosts(particles_, pairs_, wallContacts_);
-        const bool recut = (byWork ? decomposition_->rebalanceByWeight(particles_, work)
-                                   : decomposition_->rebalanceIfNeeded(particles_))
-                               .recut;
+        const bool recut = check == Check::Weights  ? decomposition_->rebalanceByWeight(particles_, weights).recut
+                           : check == Check::Counts ? decomposition_->rebalanceIfNeeded(particles_).recut
+                                                    : false;
         decomposition_->migrate(particles_);
         if (recut) decomposition_->noteBalanceAfterMigration(particles_);
     }
@@ -571,6 +592,18 @@ void Simulation::updatePairList() {
                                   : std::numeric_limits<double>::infinity();
     }
     rebuildWallCandidates();
+}
+
+namespace {
+double secondsNow() {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+}  // namespace
+
+double Simulation::busySecondsSoFar() const {
+    if (!inStep_) return busySeconds_;
+    const double collective = decomposition_ ? decomposition_->communicator().counters().seconds : 0.0;
+    return busySeconds_ + (secondsNow() - stepStartSeconds_) - (collective - stepStartCollectiveSeconds_);
 }
 
 std::vector<double> Simulation::ownedWork() const {
@@ -772,6 +805,20 @@ void Simulation::step(long steps) {
         watched = extras.displacementFrom != nullptr;
         domainTested = extras.domain != nullptr;
     };
+    // The busy time of this call (LoadBalanceWeight::Time), kept if it throws too.
+    struct BusyClock {
+        Simulation& sim;
+        explicit BusyClock(Simulation& s) : sim(s) {
+            sim.stepStartSeconds_ = secondsNow();
+            sim.stepStartCollectiveSeconds_ =
+                sim.decomposition_ ? sim.decomposition_->communicator().counters().seconds : 0.0;
+            sim.inStep_ = true;
+        }
+        ~BusyClock() {
+            sim.busySeconds_ = sim.busySecondsSoFar();
+            sim.inStep_ = false;
+        }
+    } busyClock(*this);
     for (long s = 0; s < steps; ++s) {
         if (!forcesValid_) {
             updatePairList();

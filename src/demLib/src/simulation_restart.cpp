@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <unordered_map>
 
 #include "demLib/byte_buffer.hpp"
@@ -532,87 +533,107 @@ bool Simulation::readRestartDecomposed(const std::string& path) {
     std::vector<std::vector<char>> send(ranks);
     std::string failure;
     bool failedAsInput = false;
-    if (comm.rank() == 0) {
+    auto onRankZero = [&](auto&& work) {
+        if (comm.rank() != 0) return;
         try {
-            LoadedRestart loaded = loadRestart(path, materials_.size(), walls_.size(), settings_.timeStep,
-                                               settings_.forces.wallBridges);
-            const RestartData& d = loaded.data;
-            // Written on as many ranks, cut across the same axis: its slabs
-            // give every particle back to its rank, in its order (a bitwise
-            // continuation).  Otherwise the slabs set up here, re-cut by the
-            // load balance at the next build.
-            SlabDecomposition slabs = decomposition_->slabs();
-            if (loaded.decompositionRanks == ranks && ranks > 1 && loaded.decompositionAxis == slabs.axis())
-                slabs = SlabDecomposition(ranks, static_cast<int>(loaded.decompositionAxis), loaded.cuts);
-            loaded.cuts = slabs.interiorCuts();
-            loaded.decompositionAxis = slabs.axis();
-            loaded.decompositionRanks = ranks;
-            const std::size_t n = d.id.size();
-            std::vector<RestartData> part(ranks);
-            std::unordered_map<std::int64_t, int> ownerOf;
-            ownerOf.reserve(n);
-            for (std::size_t i = 0; i < n; ++i) {
-                const int r = slabs.ownerOf(d.positionAtBuild[i], 0);
-                ownerOf[d.id[i]] = r;
-                RestartData& q = part[r];
-                q.id.push_back(d.id[i]);
-                q.position.push_back(d.position[i]);
-                q.velocity.push_back(d.velocity[i]);
-                q.omega.push_back(d.omega[i]);
-                q.force.push_back(d.force[i]);
-                q.torque.push_back(d.torque[i]);
-                q.externalForce.push_back(d.externalForce[i]);
-                q.positionAtBuild.push_back(d.positionAtBuild[i]);
-                q.radius.push_back(d.radius[i]);
-                q.mass.push_back(d.mass[i]);
-                q.material.push_back(d.material[i]);
-            }
-            auto owner = [&](std::int64_t id) {
-                const auto it = ownerOf.find(id);
-                if (it == ownerOf.end())
-                    throw InputError("restart file '" + path + "': contact refers to unknown particle id " +
-                                     std::to_string(id));
-                return it->second;
-            };
-            for (std::size_t k = 0; k < d.pairShear.size(); ++k) {
-                const int a = owner(d.pairIds[2 * k]), b = owner(d.pairIds[2 * k + 1]);
-                // To both ranks that list the pair (once when they are one).
-                for (int r : {a, b}) {
-                    RestartData& q = part[r];
-                    q.pairIds.push_back(d.pairIds[2 * k]);
-                    q.pairIds.push_back(d.pairIds[2 * k + 1]);
-                    q.pairShear.push_back(d.pairShear[k]);
-                    q.pairRolling.push_back(d.pairRolling[k]);
-                    q.pairBridge.push_back(d.pairBridge[k]);
-                    if (a == b) break;
-                }
-            }
-            for (std::size_t k = 0; k < d.wallShear.size(); ++k) {
-                RestartData& q = part[owner(d.wallKeys[3 * k])];
-                for (int c = 0; c < 3; ++c) q.wallKeys.push_back(d.wallKeys[3 * k + c]);
-                q.wallShear.push_back(d.wallShear[k]);
-                q.wallRolling.push_back(d.wallRolling[k]);
-                q.wallBridge.push_back(d.wallBridge[k]);
-                q.wallForce.push_back(d.wallForce[k]);
-            }
-            const std::vector<double> header = loaded.header();
-            for (int r = 0; r < ranks; ++r) {
-                ByteWriter w{send[r]};
-                w.putVector(header);
-                forEachField(part[r], [&](const auto& v) { w.putVector(v); });
-            }
+            work();
         } catch (const InputError& e) {
             failure = e.what();
             failedAsInput = true;
         } catch (const std::exception& e) {
             failure = e.what();
         }
-    }
-    if (comm.anyTrue(!failure.empty())) {
+    };
+    auto stopIfFailed = [&]() {
+        if (!comm.anyTrue(!failure.empty())) return;
         if (comm.rank() != 0) throw InputError("restart file '" + path + "' could not be read (see rank 0)");
         if (failedAsInput) throw InputError(failure);
         throw RuntimeError(failure);
-    }
+    };
+    std::optional<LoadedRestart> loaded;
+    onRankZero([&]() {
+        loaded.emplace(loadRestart(path, materials_.size(), walls_.size(), settings_.timeStep,
+                                   settings_.forces.wallBridges));
+    });
+    stopIfFailed();
+    // Written on as many ranks, cut across the same axis: its slabs give every
+    // particle back to its rank, in its order (a bitwise continuation).
+    // Otherwise the slabs are cut here by particle count over the file's
+    // particles (when the load balance is on): a run continued on another rank
+    // count must not leave the powder on the ranks the set-up slabs give it
+    // until the next list build, which a bed at rest may not reach for seconds.
+    const int axis = decomposition_->slabs().axis();
+    const bool keepFileCuts = comm.anyTrue(comm.rank() == 0 && ranks > 1 &&
+                                           loaded->decompositionRanks == ranks &&
+                                           loaded->decompositionAxis == axis);
+    const bool recut =
+        !keepFileCuts &&
+        decomposition_->balanceUndistributed(comm.rank() == 0 ? loaded->data.positionAtBuild : std::vector<Vec3>())
+            .recut;
+    onRankZero([&]() {
+        const RestartData& d = loaded->data;
+        const SlabDecomposition slabs = keepFileCuts
+                                            ? SlabDecomposition(ranks, axis, loaded->cuts)
+                                            : decomposition_->slabs();
+        loaded->cuts = slabs.interiorCuts();
+        loaded->decompositionAxis = slabs.axis();
+        loaded->decompositionRanks = ranks;
+        const std::size_t n = d.id.size();
+        std::vector<RestartData> part(ranks);
+        std::unordered_map<std::int64_t, int> ownerOf;
+        ownerOf.reserve(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            const int r = slabs.ownerOf(d.positionAtBuild[i], 0);
+            ownerOf[d.id[i]] = r;
+            RestartData& q = part[r];
+            q.id.push_back(d.id[i]);
+            q.position.push_back(d.position[i]);
+            q.velocity.push_back(d.velocity[i]);
+            q.omega.push_back(d.omega[i]);
+            q.force.push_back(d.force[i]);
+            q.torque.push_back(d.torque[i]);
+            q.externalForce.push_back(d.externalForce[i]);
+            q.positionAtBuild.push_back(d.positionAtBuild[i]);
+            q.radius.push_back(d.radius[i]);
+            q.mass.push_back(d.mass[i]);
+            q.material.push_back(d.material[i]);
+        }
+        auto owner = [&](std::int64_t id) {
+            const auto it = ownerOf.find(id);
+            if (it == ownerOf.end())
+                throw InputError("restart file '" + path + "': contact refers to unknown particle id " +
+                                 std::to_string(id));
+            return it->second;
+        };
+        for (std::size_t k = 0; k < d.pairShear.size(); ++k) {
+            const int a = owner(d.pairIds[2 * k]), b = owner(d.pairIds[2 * k + 1]);
+            // To both ranks that list the pair (once when they are one).
+            for (int r : {a, b}) {
+                RestartData& q = part[r];
+                q.pairIds.push_back(d.pairIds[2 * k]);
+                q.pairIds.push_back(d.pairIds[2 * k + 1]);
+                q.pairShear.push_back(d.pairShear[k]);
+                q.pairRolling.push_back(d.pairRolling[k]);
+                q.pairBridge.push_back(d.pairBridge[k]);
+                if (a == b) break;
+            }
+        }
+        for (std::size_t k = 0; k < d.wallShear.size(); ++k) {
+            RestartData& q = part[owner(d.wallKeys[3 * k])];
+            for (int c = 0; c < 3; ++c) q.wallKeys.push_back(d.wallKeys[3 * k + c]);
+            q.wallShear.push_back(d.wallShear[k]);
+            q.wallRolling.push_back(d.wallRolling[k]);
+            q.wallBridge.push_back(d.wallBridge[k]);
+            q.wallForce.push_back(d.wallForce[k]);
+        }
+        const std::vector<double> header = loaded->header();
+        for (int r = 0; r < ranks; ++r) {
+            ByteWriter w{send[r]};
+            w.putVector(header);
+            forEachField(part[r], [&](const auto& v) { w.putVector(v); });
+        }
+    });
+    stopIfFailed();
     const std::vector<std::vector<char>> received = comm.exchange(send);
     std::vector<double> header;
     RestartData d;
@@ -646,6 +667,7 @@ bool Simulation::readRestartDecomposed(const std::string& path) {
         lostMass_ = 0.0;
     }
     const std::size_t owned = particles_.size();
+    if (recut) decomposition_->noteBalanceAfterMigration(particles_);
 
     // The ghosts and the list as at the last build: ghosts chosen at the
     // build positions over the same halo, the list built from them; then the

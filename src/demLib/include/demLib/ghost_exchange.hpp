@@ -135,6 +135,14 @@ public:
     // counts; none on a rank that owns none): five reductions without a
     // re-cut.  Every rank must call the same one of the two.
     RebalanceReport rebalanceByWeight(const ParticleStore& particles, const std::vector<double>& weights);
+    // Before particles are given to the ranks (a restart file's, held by the
+    // rank that read it: `positions` there, none elsewhere): if the current
+    // slabs would give them max/mean owned above the threshold, cuts balanced
+    // by count over them, reported and counted as a re-cut.  A run continued
+    // on another rank count then starts balanced instead of waiting for its
+    // next list build.  Requires no ghosts; collective; does nothing with
+    // balancing disabled or on one rank.
+    RebalanceReport balanceUndistributed(const std::vector<Vec3>& positions);
     // Re-cuts so far, and the report of the latest rebalanceIfNeeded call.
     std::size_t recutCount() const { return recuts_; }
     const RebalanceReport& lastRebalance() const { return lastRebalance_; }

@@ -26,7 +26,9 @@ namespace dem {
 // What the slabs of a domain decomposition balance when they are re-cut.
 enum class LoadBalanceWeight {
     Particles,  // each rank's owned particles
-    Work        // their work: per particle 1 + its listed pairs + its wall contacts
+    Work,       // their work: per particle 1 + its listed pairs + its wall contacts
+    Time        // each rank's measured busy time in step() since the last check, shared
+                // equally by its owned particles (not reproducible run to run)
 };
 
 struct SimulationSettings {
@@ -71,6 +73,10 @@ struct SimulationSettings {
     // owned particle, 1 plus its pairs listed at the last build (a pair of two
     // owned particles half at each, a pair with a ghost whole, as this rank
     // computes it) plus its wall contacts: the pair walk is most of a step.
+    // Time weighs each rank's particles by the wall time it spent in step()
+    // since the last check, less its time in the DEM's collectives (waiting
+    // for the other ranks): what each rank's slab costs, whatever makes it
+    // cost (pairs, bridges, walls, a slower core).
     LoadBalanceWeight loadBalanceWeight = LoadBalanceWeight::Particles;
     double loadBalanceThreshold = GhostExchange::defaultRebalanceThreshold;
     // The axis the slabs are cut across (0 = x, 1 = y, 2 = z); -1: the longest
@@ -117,6 +123,9 @@ class Simulation {
 public:
     // Particles are sorted in space at every spatialSortInterval-th list build.
     static constexpr long spatialSortInterval = 16;
+    // LoadBalanceWeight::Time re-cuts at a list build once the busiest rank has
+    // been busy this long since the last timed check: shorter spans time noise.
+    static constexpr double minimumTimedSeconds = 0.05;
 
     Simulation(SimulationSettings settings, std::vector<Material> materials, InteractionTable interactions,
                std::vector<Wall> walls);
@@ -232,6 +241,9 @@ private:
     void updatePairList();
     // Per owned particle, its work at the last list build (LoadBalanceWeight::Work).
     std::vector<double> ownedWork() const;
+    // This rank's seconds in step() less those in the DEM's collectives, so far
+    // (the step under way included).
+    double busySecondsSoFar() const;
     void rebuildWallCandidates();
     double redistributeLiquid(double wallReach);  // returns λ, the liquid per unit weight
     // Walls within `reach` of each particle's surface at the current positions:
@@ -283,6 +295,14 @@ private:
     std::size_t lost_ = 0;
     double lostMass_ = 0.0;
     bool forcesValid_ = false;
+    // Busy time (LoadBalanceWeight::Time): seconds in finished step() calls less
+    // their collectives; the clock and collective seconds where the call under
+    // way began (inStep_); the busy seconds at the last balance check.
+    double busySeconds_ = 0.0;
+    bool inStep_ = false;
+    double stepStartSeconds_ = 0.0, stepStartCollectiveSeconds_ = 0.0;
+    double busySecondsAtCheck_ = 0.0;
+    bool timedCheckDone_ = false;
     LiquidState liquid_;
     std::unique_ptr<LiquidBridgeNetwork> liquidNetwork_;
     double largestBridge_ = 0.0;
