@@ -48,6 +48,26 @@ bool wallKeyLess(const GhostExchange::WallRecord& a, const GhostExchange::WallRe
     return a.feature < b.feature;
 }
 
+// The largest and the total over the slabs of the load the slabs give: the
+// first n particles at `positions` with `weights` (1 each when empty), each
+// to its slab's rank (`fallback` for one on a cut), added over the ranks in
+// rank order, so every rank gets the same bits.
+struct SlabLoad {
+    double largest = 0.0, total = 0.0;
+};
+SlabLoad loadOverSlabs(const Communicator& communicator, const SlabDecomposition& slabs,
+                       const std::vector<Vec3>& positions, std::size_t n, const std::vector<double>& weights,
+                       int fallback) {
+    std::vector<double> load(communicator.size(), 0.0);
+    for (std::size_t i = 0; i < n; ++i) load[slabs.ownerOf(positions[i], fallback)] += weights.empty() ? 1.0 : weights[i];
+    SlabLoad result;
+    for (double l : sumOverRanksInRankOrder(communicator, load)) {
+        result.largest = std::max(result.largest, l);
+        result.total += l;
+    }
+    return result;
+}
+
 }  // namespace
 
 GhostExchange::GhostExchange(Communicator communicator, SlabDecomposition slabs, double rebalanceThreshold)
@@ -75,6 +95,14 @@ void GhostExchange::setRebalanceThreshold(double threshold) {
         throw InputError("demLib domain decomposition: rebalance threshold " + std::to_string(threshold) +
                          "; expected max/mean owned >= 1 to re-cut at, or 0 (or infinity) for no balancing");
     rebalanceThreshold_ = threshold;
+}
+
+void GhostExchange::cutBalanced(const std::vector<Vec3>& positions, std::size_t n, const std::vector<double>& weights) {
+    const int axis = slabs_.axis();
+    std::vector<double> coordinates(n);
+    for (std::size_t i = 0; i < n; ++i) coordinates[i] = positions[i][axis];
+    setSlabs(SlabDecomposition::balanced(communicator_, axis, coordinates, weights));
+    ++recuts_;
 }
 
 GhostExchange::RebalanceReport GhostExchange::rebalanceIfNeeded(const ParticleStore& p) {
@@ -119,24 +147,12 @@ GhostExchange::RebalanceReport GhostExchange::rebalance(const ParticleStore& p, 
         recut = communicator_.anyTrue(meanLoad > 0.0 && report.imbalance > rebalanceThreshold_);
     }
     if (recut) {
-        const int axis = slabs_.axis();
-        std::vector<double> coordinates(owned);
-        for (std::size_t i = 0; i < owned; ++i) coordinates[i] = p.position[i][axis];
         // (On a rank without particles `weights` is empty and reads as unit weights: none.)
-        setSlabs(SlabDecomposition::balanced(communicator_, axis, coordinates, weights));
-        ++recuts_;
+        cutBalanced(p.position, owned, weights);
         if (weighted) {
             // The load each rank will hold: the weights by their new owner.
-            std::vector<double> load(ranks, 0.0);
-            const int me = rank();
-            for (std::size_t i = 0; i < owned; ++i) load[slabs_.ownerOf(p.position[i], me)] += weights[i];
-            load = sumOverRanksInRankOrder(communicator_, load);
-            double largest = 0.0, total = 0.0;
-            for (double l : load) {
-                largest = std::max(largest, l);
-                total += l;
-            }
-            report.loadImbalanceAfter = total > 0.0 ? largest / (total / ranks) : 1.0;
+            const SlabLoad after = loadOverSlabs(communicator_, slabs_, p.position, owned, weights, rank());
+            report.loadImbalanceAfter = after.total > 0.0 ? after.largest / (after.total / ranks) : 1.0;
         }
     }
     report.weighted = weighted;
@@ -152,26 +168,13 @@ GhostExchange::RebalanceReport GhostExchange::balanceUndistributed(const std::ve
     RebalanceReport report;
     const int ranks = communicator_.size();
     if (balancingEnabled() && ranks > 1) {
-        // The counts the current slabs would give, summed over the ranks.
-        std::vector<double> counts(ranks, 0.0);
-        for (const Vec3& x : positions) counts[slabs_.ownerOf(x, 0)] += 1.0;
-        counts = sumOverRanksInRankOrder(communicator_, counts);
-        double largest = 0.0, total = 0.0;
-        for (double c : counts) {
-            largest = std::max(largest, c);
-            total += c;
-        }
-        report.maxOwned = static_cast<std::int64_t>(largest);
-        report.meanOwned = total / ranks;
-        report.imbalance = total > 0.0 ? largest / report.meanOwned : 0.0;
-        report.recut = total > 0.0 && report.imbalance > rebalanceThreshold_;
-        if (report.recut) {
-            const int axis = slabs_.axis();
-            std::vector<double> coordinates(positions.size());
-            for (std::size_t i = 0; i < positions.size(); ++i) coordinates[i] = positions[i][axis];
-            setSlabs(SlabDecomposition::balanced(communicator_, axis, coordinates));
-            ++recuts_;
-        }
+        // The counts the current slabs would give.
+        const SlabLoad counts = loadOverSlabs(communicator_, slabs_, positions, positions.size(), {}, 0);
+        report.maxOwned = static_cast<std::int64_t>(counts.largest);
+        report.meanOwned = counts.total / ranks;
+        report.imbalance = counts.total > 0.0 ? counts.largest / report.meanOwned : 0.0;
+        report.recut = counts.total > 0.0 && report.imbalance > rebalanceThreshold_;
+        if (report.recut) cutBalanced(positions, positions.size(), {});
     }
     report.cuts = slabs_.interiorCuts();
     lastRebalance_ = report;

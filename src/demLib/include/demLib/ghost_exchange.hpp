@@ -171,6 +171,10 @@ private:
     std::vector<PairRecord> pairStash_;
     std::vector<WallRecord> wallStash_;
     RebalanceReport rebalance(const ParticleStore& particles, const std::vector<double>& weights, bool weighted);
+    // New cuts along the slabs' axis holding equal shares of `weights` (1 each
+    // when empty) of the first n particles at `positions` (collective), counted
+    // as a re-cut.
+    void cutBalanced(const std::vector<Vec3>& positions, std::size_t n, const std::vector<double>& weights);
     double rebalanceThreshold_ = defaultRebalanceThreshold;
     std::size_t recuts_ = 0;
     RebalanceReport lastRebalance_;
