@@ -102,6 +102,15 @@ PairState seenFromOther(PairState s) {
     return s;
 }
 
+// What `byId` maps a contact's particle id to (an index, a rank); an id the
+// file's particles lack is an input error naming the file.
+int contactParticle(const std::unordered_map<std::int64_t, int>& byId, std::int64_t id, const std::string& path) {
+    const auto it = byId.find(id);
+    if (it == byId.end())
+        throw InputError("restart file '" + path + "': contact refers to unknown particle id " + std::to_string(id));
+    return it->second;
+}
+
 }  // namespace
 
 void Simulation::writeRestart(const std::string& path) const {
@@ -447,13 +456,7 @@ bool Simulation::readRestart(const std::string& path) {
     std::unordered_map<std::int64_t, int> indexOf;
     indexOf.reserve(n);
     for (std::size_t i = 0; i < n; ++i) indexOf[particles_.id[i]] = static_cast<int>(i);
-    auto lookup = [&](std::int64_t id) {
-        const auto it = indexOf.find(id);
-        if (it == indexOf.end())
-            throw InputError("restart file '" + path + "': contact refers to unknown particle id " +
-                             std::to_string(id));
-        return it->second;
-    };
+    auto lookup = [&](std::int64_t id) { return contactParticle(indexOf, id, path); };
 
     pairs_.restore(particles_, d.positionAtBuild, loaded.listBuildCount);
     for (std::size_t k = 0; k < d.pairShear.size(); ++k) {
@@ -598,13 +601,7 @@ bool Simulation::readRestartDecomposed(const std::string& path) {
             q.mass.push_back(d.mass[i]);
             q.material.push_back(d.material[i]);
         }
-        auto owner = [&](std::int64_t id) {
-            const auto it = ownerOf.find(id);
-            if (it == ownerOf.end())
-                throw InputError("restart file '" + path + "': contact refers to unknown particle id " +
-                                 std::to_string(id));
-            return it->second;
-        };
+        auto owner = [&](std::int64_t id) { return contactParticle(ownerOf, id, path); };
         for (std::size_t k = 0; k < d.pairShear.size(); ++k) {
             const int a = owner(d.pairIds[2 * k]), b = owner(d.pairIds[2 * k + 1]);
             // To both ranks that list the pair (once when they are one).
