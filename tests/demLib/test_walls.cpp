@@ -561,6 +561,63 @@ TEST(TriangleMesh, GridQueryFindsTheNearestSurfacePointAtConstantCost) {
     EXPECT_LT(plate.candidateCount(Vec3(0.5, 0.5, 0.002), 0.005), 40u);
 }
 
+TEST(TriangleMesh, EarlyRejectionKeepsEveryTouchedFace) {
+    // findContacts skips a candidate whose plane or box the sphere does not
+    // reach before the closest-point search.  Spheres at a relative 1e-9, 1e-6
+    // or 1e-3 of the contact distance from a face, on either side, near its
+    // edges or inside it: every face that the brute-force closest point shows
+    // touched (region Face, distance < radius) must be among the contacts.
+    std::vector<Triangle> triangles;
+    const int rings = 12, segments = 12;
+    auto at = [&](int i, int j) {
+        const double theta = pi * i / rings, phi = 2 * pi * j / segments;
+        return Vec3(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
+    };
+    for (int i = 0; i < rings; ++i) {
+        for (int j = 0; j < segments; ++j) {
+            if (i > 0) triangles.push_back({at(i, j), at(i + 1, j), at(i, j + 1)});
+            if (i < rings - 1) triangles.push_back({at(i, j + 1), at(i + 1, j), at(i + 1, j + 1)});
+        }
+    }
+    const dem::TriangleMesh ball(triangles);
+    const dem::TriangleMesh plate(squareTriangles(1.0, 10));
+    std::mt19937_64 rng(31);
+    std::uniform_real_distribution<double> uniform(0.0, 1.0);
+    long faces = 0, backSide = 0;
+    for (const dem::TriangleMesh* mesh : {&ball, &plate}) {
+        for (int trial = 0; trial < 40000; ++trial) {
+            const std::size_t t = std::min(mesh->triangleCount() - 1, std::size_t(uniform(rng) * mesh->triangleCount()));
+            const Triangle tri = mesh->triangle(t);
+            // A point inside the triangle, half the time within 1e-6 of an edge.
+            double u = uniform(rng), v = uniform(rng);
+            if (u + v > 1.0) u = 1.0 - u, v = 1.0 - v;
+            if (uniform(rng) < 0.5) v = 1e-6 * uniform(rng);
+            const Vec3 onFace = tri[0] + u * (tri[1] - tri[0]) + v * (tri[2] - tri[0]);
+            const double radius = 0.01 + 0.04 * uniform(rng);
+            const double scale = std::pow(10.0, -3.0 * (1 + int(uniform(rng) * 3)));
+            const double side = uniform(rng) < 0.5 ? 1.0 : -1.0;
+            const Vec3 centre = onFace + side * radius * (1.0 + scale * (2.0 * uniform(rng) - 1.0)) * mesh->faceNormal(t);
+            const auto contacts = contactsOf(*mesh, centre, radius);
+            for (std::size_t k = 0; k < mesh->triangleCount(); ++k) {
+                const Triangle other = mesh->triangle(k);
+                const auto closest = dem::closestPointOnTriangle(centre, other[0], other[1], other[2]);
+                const double distance = (closest.point - centre).norm();
+                if (closest.region != dem::TriangleClosestPoint::Region::Face || distance >= radius ||
+                    radius - distance < 1e-13)
+                    continue;
+                bool reported = false;
+                for (const auto& contact : contacts) reported |= contact.feature == mesh->faceFeature(k);
+                ASSERT_TRUE(reported) << "triangle " << k << " at " << distance << " of radius " << radius;
+                ++faces;
+                backSide += mesh->faceNormal(k).dot(centre - closest.point) < 0.0;
+            }
+        }
+    }
+    // Not vacuous: many touched faces, from both sides.
+    EXPECT_GT(faces, 30000);
+    EXPECT_GT(backSide, 10000);
+}
+
 // ================================================================ STL
 
 TEST(Stl, AsciiAndBinaryGiveIdenticalTriangles) {

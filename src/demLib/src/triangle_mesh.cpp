@@ -364,6 +364,12 @@ void TriangleMesh::weld(const std::vector<Triangle>& triangles, const std::strin
         }
         triangleVertices_.push_back(ids);
         faceNormals_.push_back(doubleArea.normalized());
+        planeOffsets_.push_back(faceNormals_.back().dot(a));
+        BoundingBox box;
+        box.expand(a);
+        box.expand(b);
+        box.expand(c);
+        triangleBoxes_.push_back(box);
     }
     if (triangleVertices_.empty()) {
         throw InputError(sourceName + ": all " + std::to_string(triangles.size()) +
@@ -634,8 +640,16 @@ void TriangleMesh::findContacts(const Vec3& centre, double radius, std::vector<W
     thread_local std::vector<Candidate> candidates;
     candidates.clear();
     const double radius2 = radius * radius;
+    // A triangle farther than this from the sphere's centre along its normal,
+    // or whose box the sphere misses, cannot be touched.  The welding tolerance
+    // keeps every triangle the closest-point test below would take.
+    const double rejectBeyond = radius + tolerance_;
 
     forEachCandidate(centre, radius, [&](int t) {
+        if (std::abs(faceNormals_[t].dot(centre) - planeOffsets_[t]) >= rejectBeyond ||
+            !triangleBoxes_[t].overlapsSphere(centre, rejectBeyond)) {
+            return;
+        }
         const auto& tv = triangleVertices_[t];
         const TriangleClosestPoint closest =
             closestPointOnTriangle(centre, vertices_[tv[0]], vertices_[tv[1]], vertices_[tv[2]]);

@@ -112,6 +112,10 @@ private:
     std::vector<Vec3> vertices_;
     std::vector<std::array<int, 3>> triangleVertices_;
     std::vector<Vec3> faceNormals_;
+    // Per triangle, for rejecting far candidates before the closest-point
+    // search: the plane's offset (normal . a) and the triangle's box.
+    std::vector<double> planeOffsets_;
+    std::vector<BoundingBox> triangleBoxes_;
     BoundingBox box_;
     double tolerance_ = 0.0;
     bool closed_ = false;
