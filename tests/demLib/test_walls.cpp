@@ -2,6 +2,7 @@
 // form or an independent brute-force computation.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -616,6 +617,68 @@ TEST(TriangleMesh, EarlyRejectionKeepsEveryTouchedFace) {
     // Not vacuous: many touched faces, from both sides.
     EXPECT_GT(faces, 30000);
     EXPECT_GT(backSide, 10000);
+}
+
+TEST(TriangleMesh, ListedTrianglesGiveTheContactsOfTheWholeMesh) {
+    // The step searches a mesh wall only over the triangles listed within
+    // radius + skin of the particle at the list build; it moves less than
+    // skin/2 before the next one.  Its contacts must be those of the whole
+    // mesh, bit for bit, in whatever order the list holds the triangles.
+    std::vector<Triangle> triangles;
+    const int rings = 12, segments = 12;
+    auto at = [&](int i, int j) {
+        const double theta = pi * i / rings, phi = 2 * pi * j / segments;
+        return Vec3(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
+    };
+    for (int i = 0; i < rings; ++i) {
+        for (int j = 0; j < segments; ++j) {
+            if (i > 0) triangles.push_back({at(i, j), at(i + 1, j), at(i, j + 1)});
+            if (i < rings - 1) triangles.push_back({at(i, j + 1), at(i + 1, j), at(i + 1, j + 1)});
+        }
+    }
+    const dem::TriangleMesh ball(triangles);
+    const dem::TriangleMesh plate(squareTriangles(1.0, 10));
+    std::mt19937_64 rng(37);
+    std::uniform_real_distribution<double> uniform(0.0, 1.0);
+    long contacts = 0, edgesAndVertices = 0;
+    for (const dem::TriangleMesh* mesh : {&ball, &plate}) {
+        for (int trial = 0; trial < 20000; ++trial) {
+            const double radius = 0.02 + 0.06 * uniform(rng), skin = 0.5 * radius;
+            // Near the surface: a vertex or a point of a triangle, pushed off it.
+            const std::size_t t = std::min(mesh->triangleCount() - 1, std::size_t(uniform(rng) * mesh->triangleCount()));
+            const Triangle tri = mesh->triangle(t);
+            const double u = uniform(rng), v = (1.0 - u) * uniform(rng);
+            const Vec3 onSurface = tri[0] + u * (tri[1] - tri[0]) + v * (tri[2] - tri[0]);
+            const Vec3 listedAt = onSurface + (radius + 0.5 * skin) * uniform(rng) * randomUnit(rng);
+            std::vector<int> listed;
+            mesh->nearTriangles(listedAt, radius + skin, listed);
+            ASSERT_TRUE(std::is_sorted(listed.begin(), listed.end()));
+            // Moved by up to skin/2 (just under): half the time straight at the
+            // surface point it was pushed from, else in any direction.
+            const Vec3 towards = (onSurface - listedAt).normalized();
+            const Vec3 centre = uniform(rng) < 0.5 && (onSurface - listedAt).norm() > 0.5 * skin
+                                    ? Vec3(listedAt + 0.4999 * skin * towards)
+                                    : Vec3(listedAt + 0.4999 * skin * std::cbrt(uniform(rng)) * randomUnit(rng));
+            const auto whole = contactsOf(*mesh, centre, radius);
+            for (int order = 0; order < 2; ++order) {
+                if (order == 1) std::reverse(listed.begin(), listed.end());
+                std::vector<WallContact> among;
+                mesh->findContactsAmong(centre, radius, listed.data(), int(listed.size()), among);
+                ASSERT_EQ(among.size(), whole.size()) << "trial " << trial;
+                for (std::size_t k = 0; k < whole.size(); ++k) {
+                    EXPECT_EQ(among[k].feature, whole[k].feature);
+                    EXPECT_EQ(among[k].overlap, whole[k].overlap);
+                    EXPECT_EQ(among[k].point, whole[k].point);
+                    EXPECT_EQ(among[k].normal, whole[k].normal);
+                }
+            }
+            contacts += long(whole.size());
+            for (const auto& c : whole) edgesAndVertices += c.feature % 4 != 0 || c.feature >= 4 * int(mesh->triangleCount());
+        }
+    }
+    // Not vacuous: many contacts, edge and vertex ones among them.
+    EXPECT_GT(contacts, 20000);
+    EXPECT_GT(edgesAndVertices, 1000);
 }
 
 // ================================================================ STL

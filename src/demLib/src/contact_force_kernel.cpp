@@ -551,9 +551,7 @@ private:
             const Vec3 xi = p.position[i];
             const double ri = p.radius[i];
             // Only the static walls listed near i at the last list build, and the moving walls.
-            const int* listed = candidates.walls().data();
-            query.forEachNearIn(listed + candidates.offsets()[i], listed + candidates.offsets()[i + 1],
-                                candidates.movingWalls(), xi, ri, reach, [&](int w, const WallContact& c) {
+            query.forEachNearIn(candidates, i, xi, ri, reach, [&](int w, const WallContact& c) {
                 const bool touching = c.overlap > 0.0;
                 if (!touching && !bridges) return;
                 WallContactRecord rec;

@@ -628,7 +628,35 @@ bool TriangleMesh::isClosestForAll(const Vec3& centre, const Vec3& point, const 
     return true;
 }
 
+bool TriangleMesh::mayTouch(int t, const Vec3& centre, double reach) const {
+    return std::abs(faceNormals_[t].dot(centre) - planeOffsets_[t]) < reach &&
+           triangleBoxes_[t].overlapsSphere(centre, reach);
+}
+
 void TriangleMesh::findContacts(const Vec3& centre, double radius, std::vector<WallContact>& out) const {
+    contactsFrom(centre, radius, [&](auto&& visit) { forEachCandidate(centre, radius, visit); }, out);
+}
+
+void TriangleMesh::findContactsAmong(const Vec3& centre, double radius, const int* triangles, int count,
+                                     std::vector<WallContact>& out) const {
+    contactsFrom(centre, radius, [&](auto&& visit) { for (int k = 0; k < count; ++k) visit(triangles[k]); }, out);
+}
+
+void TriangleMesh::nearTriangles(const Vec3& centre, double radius, std::vector<int>& out) const {
+    const std::size_t first = out.size();
+    const double reach = radius + tolerance_;
+    forEachCandidate(centre, radius, [&](int t) {
+        if (!mayTouch(t, centre, reach)) return;
+        const auto& tv = triangleVertices_[t];
+        const Vec3 closest = closestPointOnTriangle(centre, vertices_[tv[0]], vertices_[tv[1]], vertices_[tv[2]]).point;
+        if ((closest - centre).norm() < reach) out.push_back(t);
+    });
+    std::sort(out.begin() + static_cast<std::ptrdiff_t>(first), out.end());
+}
+
+template <class ForEachTriangle>
+void TriangleMesh::contactsFrom(const Vec3& centre, double radius, ForEachTriangle&& forEachTriangle,
+                                std::vector<WallContact>& out) const {
     using Region = TriangleClosestPoint::Region;
     struct Candidate {
         Vec3 point;
@@ -645,9 +673,8 @@ void TriangleMesh::findContacts(const Vec3& centre, double radius, std::vector<W
     // keeps every triangle the closest-point test below would take.
     const double rejectBeyond = radius + tolerance_;
 
-    forEachCandidate(centre, radius, [&](int t) {
-        if (std::abs(faceNormals_[t].dot(centre) - planeOffsets_[t]) >= rejectBeyond ||
-            !triangleBoxes_[t].overlapsSphere(centre, rejectBeyond)) {
+    forEachTriangle([&](int t) {
+        if (!mayTouch(t, centre, rejectBeyond)) {
             return;
         }
         const auto& tv = triangleVertices_[t];
@@ -680,8 +707,11 @@ void TriangleMesh::findContacts(const Vec3& centre, double radius, std::vector<W
         candidates.push_back(candidate);
     });
 
+    // Ties broken by triangle: the same contacts whatever order the triangles came in.
     std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
-        return a.rank != b.rank ? a.rank < b.rank : a.distance < b.distance;
+        if (a.rank != b.rank) return a.rank < b.rank;
+        if (a.distance != b.distance) return a.distance < b.distance;
+        return a.triangle < b.triangle;
     });
     const std::size_t firstNew = out.size();
     for (const Candidate& candidate : candidates) {

@@ -16,13 +16,38 @@ void Wall::findContacts(const Vec3& centre, double radius, double time, std::vec
 
 void Wall::findContacts(const Vec3& centre, double radius, double time, const RigidTransform& pose,
                         std::vector<WallContact>& out) const {
+    findContactsWith(centre, time, pose, out, [&](const Vec3& reference) {
+        std::visit([&](const auto& surface) { surface.findContacts(reference, radius, out); }, shape);
+    });
+}
+
+void Wall::findContactsAmong(const Vec3& centre, double radius, double time, const RigidTransform& pose,
+                             const int* triangles, int count, std::vector<WallContact>& out) const {
+    const auto* mesh = std::get_if<MeshWall>(&shape);
+    if (!mesh) {
+        findContacts(centre, radius, time, pose, out);
+        return;
+    }
+    findContactsWith(centre, time, pose, out, [&](const Vec3& reference) {
+        mesh->mesh().findContactsAmong(reference, radius, triangles, count, out);
+    });
+}
+
+void Wall::nearTriangles(const Vec3& centre, double radius, double time, std::vector<int>& out) const {
+    const auto* mesh = std::get_if<MeshWall>(&shape);
+    if (!mesh || !isActive(time)) return;
+    mesh->mesh().nearTriangles(motion.isStatic() ? centre : motion.at(time).applyInverse(centre), radius, out);
+}
+
+template <class Search>
+void Wall::findContactsWith(const Vec3& centre, double time, const RigidTransform& pose,
+                            std::vector<WallContact>& out, Search&& search) const {
     if (motion.isStatic()) {
-        std::visit([&](const auto& surface) { surface.findContacts(centre, radius, out); }, shape);
+        search(centre);
         return;  // wall velocity stays zero
     }
     const std::size_t firstNew = out.size();
-    const Vec3 referenceCentre = pose.applyInverse(centre);
-    std::visit([&](const auto& surface) { surface.findContacts(referenceCentre, radius, out); }, shape);
+    search(pose.applyInverse(centre));
     for (std::size_t i = firstNew; i < out.size(); ++i) {
         WallContact& contact = out[i];
         contact.normal = pose.applyToDirection(contact.normal);

@@ -24,6 +24,12 @@ public:
     // Static walls near particle i: entries [offsets()[i], offsets()[i+1]) of walls().
     const std::vector<int>& offsets() const { return offsets_; }
     const std::vector<int>& walls() const { return walls_; }
+    // For entry k of walls() that is a mesh: the triangles within reach of the
+    // particle at build time, entries [triangleOffsets()[k], triangleOffsets()[k+1])
+    // of triangles() (empty for other shapes).  The step searches only these
+    // (a mesh's grid walk was most of the cost of a die made of STL walls).
+    const std::vector<int>& triangleOffsets() const { return triangleOffsets_; }
+    const std::vector<int>& triangles() const { return triangles_; }
     // Walls under way in a motion segment at build time: checked for every particle.
     const std::vector<int>& movingWalls() const { return moving_; }
     // The first time a wall starts or stops moving after the build.
@@ -33,6 +39,8 @@ public:
 private:
     std::vector<int> offsets_{0};
     std::vector<int> walls_;
+    std::vector<int> triangleOffsets_{0};
+    std::vector<int> triangles_;
     std::vector<int> moving_;
     double validUntil_ = 0.0;
 };

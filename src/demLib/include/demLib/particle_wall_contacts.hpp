@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "demLib/contact_law.hpp"
+#include "demLib/particle_wall_broad_search.hpp"
 #include "demLib/wall.hpp"
 
 namespace dem {
@@ -87,26 +88,39 @@ public:
         for (int w = 0; w < static_cast<int>(walls_.size()); ++w) visitWall(w, centre, radius, reach, visit);
     }
 
-    // The same over the walls listed in the two ascending lists only (a
-    // particle's static candidates and the moving walls), in index order.
+    // The same over the walls listed near particle i at the last build (its
+    // static candidates, a mesh searched over its listed triangles only) and
+    // the moving walls, in index order.
     template <class Visit>
-    void forEachNearIn(const int* first, const int* last, const std::vector<int>& moving, const Vec3& centre,
-                       double radius, double reach, Visit&& visit) {
+    void forEachNearIn(const ParticleWallCandidates& candidates, int i, const Vec3& centre, double radius,
+                       double reach, Visit&& visit) {
+        int k = candidates.offsets()[i];
+        const int last = candidates.offsets()[i + 1];
+        const std::vector<int>& moving = candidates.movingWalls();
         auto m = moving.begin();
-        while (first != last || m != moving.end()) {
-            const bool takeStatic = m == moving.end() || (first != last && *first < *m);
-            const int w = takeStatic ? *first++ : *m++;
-            visitWall(w, centre, radius, reach, visit);
+        while (k != last || m != moving.end()) {
+            if (m == moving.end() || (k != last && candidates.walls()[k] < *m)) {
+                const int first = candidates.triangleOffsets()[k];
+                visitWall(candidates.walls()[k], centre, radius, reach, visit, candidates.triangles().data() + first,
+                          candidates.triangleOffsets()[k + 1] - first);
+                ++k;
+            } else {
+                visitWall(*m++, centre, radius, reach, visit);
+            }
         }
     }
 
 private:
+    // triangles: a mesh wall's listed triangles (count of them), or null to
+    // search the whole wall.
     template <class Visit>
-    void visitWall(int w, const Vec3& centre, double radius, double reach, Visit& visit) {
+    void visitWall(int w, const Vec3& centre, double radius, double reach, Visit& visit,
+                   const int* triangles = nullptr, int count = 0) {
         const double searchRadius = radius + reach;
         if (!active_[w] || !boxes_[w].overlapsSphere(centre, searchRadius)) return;
         found_.clear();
-        walls_[w].findContacts(centre, searchRadius, time_, poses_[w], found_);
+        if (triangles) walls_[w].findContactsAmong(centre, searchRadius, time_, poses_[w], triangles, count, found_);
+        else walls_[w].findContacts(centre, searchRadius, time_, poses_[w], found_);
         for (WallContact& c : found_) {
             if (reach != 0.0) c.overlap -= reach;
             visit(w, c);

@@ -75,6 +75,14 @@ public:
     // independent of the mesh size: only triangles in the grid cells overlapped
     // by the sphere's box are tested.
     void findContacts(const Vec3& centre, double radius, std::vector<WallContact>& out) const;
+    // The same over the given triangles only: the contacts are those of
+    // findContacts whenever the list holds every triangle within `radius` of
+    // the centre (nearTriangles of a larger sphere around it).
+    void findContactsAmong(const Vec3& centre, double radius, const int* triangles, int count,
+                           std::vector<WallContact>& out) const;
+    // Appends the triangles whose surface lies within `radius` of the centre
+    // (ascending; a few more within the welding tolerance).
+    void nearTriangles(const Vec3& centre, double radius, std::vector<int>& out) const;
     // How many triangles a query for this sphere tests (diagnostics, tests).
     std::size_t candidateCount(const Vec3& centre, double radius) const;
 
@@ -108,6 +116,11 @@ private:
     bool isClosestForAll(const Vec3& centre, const Vec3& point, const int* neighbours, int count) const;
     template <class Visit>
     void forEachCandidate(const Vec3& centre, double radius, Visit&& visit) const;
+    // Whether the sphere can touch triangle t: its plane and box within reach.
+    bool mayTouch(int t, const Vec3& centre, double reach) const;
+    template <class ForEachTriangle>
+    void contactsFrom(const Vec3& centre, double radius, ForEachTriangle&& forEachTriangle,
+                      std::vector<WallContact>& out) const;
 
     std::vector<Vec3> vertices_;
     std::vector<std::array<int, 3>> triangleVertices_;
@@ -139,6 +152,8 @@ public:
         mesh_->findContacts(centre, radius, out);
     }
     BoundingBox boundingBox() const { return mesh_->boundingBox(); }
+    // Shared, so that a copy of the wall keeps pointing at the same triangles.
+    const std::shared_ptr<const TriangleMesh>& sharedMesh() const { return mesh_; }
 
 private:
     std::shared_ptr<const TriangleMesh> mesh_;

@@ -34,6 +34,14 @@ struct Wall {
     // caller already has: a moving wall is met by every particle in a step.
     void findContacts(const Vec3& centre, double radius, double time, const RigidTransform& pose,
                       std::vector<WallContact>& out) const;
+    // A mesh wall's contacts among the given triangles only (their ids as
+    // nearTriangles listed them); any other shape ignores the list.
+    void findContactsAmong(const Vec3& centre, double radius, double time, const RigidTransform& pose,
+                           const int* triangles, int count, std::vector<WallContact>& out) const;
+    // A mesh wall's triangles within `radius` of the sphere centre at `time`
+    // (ascending); nothing for any other shape.  Whether it is a mesh: isMesh().
+    void nearTriangles(const Vec3& centre, double radius, double time, std::vector<int>& out) const;
+    bool isMesh() const { return std::holds_alternative<MeshWall>(shape); }
 
     // World-frame axis-aligned box enclosing the wall at `time` (unbounded for
     // planes, empty once removed).  A sphere whose box misses it has no
@@ -55,6 +63,13 @@ struct Wall {
     // (particles touch the wall only there).  Infinite for a rotating plane
     // without a domain: its material reaches arbitrarily far.
     double largestSpeed(std::size_t k, const AxisAlignedBox* domain) const;
+
+private:
+    // search(reference centre) appends the shape's contacts; this maps the
+    // new ones to the world frame of a moving wall.
+    template <class Search>
+    void findContactsWith(const Vec3& centre, double time, const RigidTransform& pose, std::vector<WallContact>& out,
+                          Search&& search) const;
 };
 
 }  // namespace dem
