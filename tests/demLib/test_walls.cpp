@@ -91,6 +91,22 @@ std::vector<Triangle> squareTriangles(double side, int cells) {
     return triangles;
 }
 
+// Unit sphere as a UV mesh: rings x segments, slivers at the poles.
+std::vector<Triangle> uvSphereTriangles(int rings, int segments) {
+    std::vector<Triangle> triangles;
+    auto at = [&](int i, int j) {
+        const double theta = pi * i / rings, phi = 2 * pi * j / segments;
+        return Vec3(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
+    };
+    for (int i = 0; i < rings; ++i) {
+        for (int j = 0; j < segments; ++j) {
+            if (i > 0) triangles.push_back({at(i, j), at(i + 1, j), at(i, j + 1)});
+            if (i < rings - 1) triangles.push_back({at(i, j + 1), at(i + 1, j), at(i + 1, j + 1)});
+        }
+    }
+    return triangles;
+}
+
 std::vector<WallContact> contactsOf(const dem::TriangleMesh& mesh, const Vec3& centre, double radius) {
     std::vector<WallContact> contacts;
     mesh.findContacts(centre, radius, contacts);
@@ -512,19 +528,7 @@ TEST(TriangleMesh, ConcaveCornerKeepsOneContactPerFace) {
 
 TEST(TriangleMesh, GridQueryFindsTheNearestSurfacePointAtConstantCost) {
     // UV sphere with ~4900 triangles; compare the deepest contact with all triangles.
-    std::vector<Triangle> triangles;
-    const int rings = 50, segments = 50;
-    auto at = [&](int i, int j) {
-        const double theta = pi * i / rings, phi = 2 * pi * j / segments;
-        return Vec3(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
-    };
-    for (int i = 0; i < rings; ++i) {
-        for (int j = 0; j < segments; ++j) {
-            if (i > 0) triangles.push_back({at(i, j), at(i + 1, j), at(i, j + 1)});
-            if (i < rings - 1) triangles.push_back({at(i, j + 1), at(i + 1, j), at(i + 1, j + 1)});
-        }
-    }
-    const dem::TriangleMesh ball(triangles);
+    const dem::TriangleMesh ball(uvSphereTriangles(50, 50));
     std::mt19937_64 rng(5);
     std::uniform_real_distribution<double> uniform(-1.0, 1.0);
     std::size_t maxCandidates = 0, totalCandidates = 0;
@@ -568,19 +572,7 @@ TEST(TriangleMesh, EarlyRejectionKeepsEveryTouchedFace) {
     // or 1e-3 of the contact distance from a face, on either side, near its
     // edges or inside it: every face that the brute-force closest point shows
     // touched (region Face, distance < radius) must be among the contacts.
-    std::vector<Triangle> triangles;
-    const int rings = 12, segments = 12;
-    auto at = [&](int i, int j) {
-        const double theta = pi * i / rings, phi = 2 * pi * j / segments;
-        return Vec3(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
-    };
-    for (int i = 0; i < rings; ++i) {
-        for (int j = 0; j < segments; ++j) {
-            if (i > 0) triangles.push_back({at(i, j), at(i + 1, j), at(i, j + 1)});
-            if (i < rings - 1) triangles.push_back({at(i, j + 1), at(i + 1, j), at(i + 1, j + 1)});
-        }
-    }
-    const dem::TriangleMesh ball(triangles);
+    const dem::TriangleMesh ball(uvSphereTriangles(12, 12));
     const dem::TriangleMesh plate(squareTriangles(1.0, 10));
     std::mt19937_64 rng(31);
     std::uniform_real_distribution<double> uniform(0.0, 1.0);
@@ -624,19 +616,7 @@ TEST(TriangleMesh, ListedTrianglesGiveTheContactsOfTheWholeMesh) {
     // radius + skin of the particle at the list build; it moves less than
     // skin/2 before the next one.  Its contacts must be those of the whole
     // mesh, bit for bit, in whatever order the list holds the triangles.
-    std::vector<Triangle> triangles;
-    const int rings = 12, segments = 12;
-    auto at = [&](int i, int j) {
-        const double theta = pi * i / rings, phi = 2 * pi * j / segments;
-        return Vec3(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
-    };
-    for (int i = 0; i < rings; ++i) {
-        for (int j = 0; j < segments; ++j) {
-            if (i > 0) triangles.push_back({at(i, j), at(i + 1, j), at(i, j + 1)});
-            if (i < rings - 1) triangles.push_back({at(i, j + 1), at(i + 1, j), at(i + 1, j + 1)});
-        }
-    }
-    const dem::TriangleMesh ball(triangles);
+    const dem::TriangleMesh ball(uvSphereTriangles(12, 12));
     const dem::TriangleMesh plate(squareTriangles(1.0, 10));
     std::mt19937_64 rng(37);
     std::uniform_real_distribution<double> uniform(0.0, 1.0);
