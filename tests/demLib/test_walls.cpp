@@ -17,11 +17,14 @@
 #include <Eigen/Geometry>
 
 #include "demLib/error.hpp"
+#include "demLib/particle_wall_broad_search.hpp"
+#include "demLib/particle_wall_contacts.hpp"
 #include "demLib/triangle_mesh.hpp"
 #include "demLib/wall.hpp"
 #include "demLib/wall_cylinder.hpp"
 #include "demLib/wall_motion.hpp"
 #include "demLib/wall_plane.hpp"
+#include "sand_without_gravity.hpp"
 
 namespace {
 
@@ -1058,4 +1061,89 @@ TEST(Wall, LargestSpeedOfEachMotionSegment) {
                    dem::WallMotion(), 0};
     tube.motion.addRotation(0.0, 1.0, Vec3(0, 0, 0), Vec3(1, 0, 0), 3.0);
     EXPECT_DOUBLE_EQ(tube.largestSpeed(0, nullptr), 3.0 * std::hypot(0.5, 2.0));
+}
+
+TEST(ParticleWallCandidates, MovingMeshListedWithinItsTravelGivesTheContactsOfTheWholeMesh) {
+    // A mesh wall under way (a ball translating, then turning about an axis
+    // off its centre) is listed by triangles within radius + skin + allowance
+    // of each particle, and the lists are built again once any point of it may
+    // have moved the allowance.  Until then a particle has moved at most the
+    // skin since the build (a build between two neighbour-list builds), so the
+    // listed search must give the whole mesh's contacts, bit for bit.
+    dem::WallMotion motion;
+    motion.addTranslation(0.0, 0.5, Vec3(1.0, 0.5, 0.0));
+    motion.addRotation(0.5, 1.0, Vec3(0.3, 0.0, 0.0), Vec3(0.2, 0.1, 1.0), 2.0);
+    const std::vector<dem::Wall> walls{
+        {"ball", dem::MeshWall(std::make_shared<const dem::TriangleMesh>(uvSphereTriangles(50, 50))), motion, 0}};
+    const double radius = 0.05, skin = 0.02, allowance = 0.5 * skin, dt = 1e-5;
+    std::mt19937_64 rng(41);
+    std::uniform_real_distribution<double> uniform(0.0, 1.0);
+    long contacts = 0, reachedByTheAllowance = 0;
+    for (const double built : {0.1, 0.6}) {
+        // Particles around the ball where it is at the build, their gaps to
+        // its surface spread over [-r/2, skin + allowance + 0.02], half of them
+        // in [skin, skin + allowance].
+        const dem::RigidTransform pose = motion.at(built);
+        dem::ParticleStore particles;
+        std::vector<double> gapAtBuild;
+        for (int i = 0; i < 4000; ++i) {
+            const double gap = i % 2 ? -0.5 * radius + (0.5 * radius + skin + allowance + 0.02) * uniform(rng)
+                                     : skin + allowance * uniform(rng);  // only the allowance lists these
+            particles.add(i, pose.apply((1.0 + radius + gap) * randomUnit(rng)), Vec3::Zero(), radius, 2500, 0);
+            gapAtBuild.push_back(gap);
+        }
+        dem::ParticleWallCandidates candidates;
+        candidates.build(particles, walls, built, skin, allowance);
+        EXPECT_TRUE(candidates.movingWalls().empty());  // listed by triangles instead
+        // The last time the lists still hold.
+        double t = built;
+        while (!candidates.movedTooFar(walls, t + dt) && t < built + 0.2) t += dt;
+        ASSERT_LT(t, built + 0.2) << "never asked for a rebuild";
+        if (built < 0.5) {
+            // A translation at |v| = 1.118 m/s: the bound is the travel itself.
+            EXPECT_NEAR(t - built, allowance / std::sqrt(1.25), 2 * dt);
+        }
+        // Each particle moved by the skin straight at the ball's centre now.
+        const Vec3 centreNow = motion.at(t).translation;
+        dem::WallProximityQuery query(walls, t);
+        for (int i = 0; i < int(particles.size()); ++i) {
+            const Vec3 x = particles.position[i] + skin * (centreNow - particles.position[i]).normalized();
+            std::vector<std::pair<int, WallContact>> listed, whole;
+            query.forEachNearIn(candidates, i, x, radius, 0.0,
+                                [&](int w, const WallContact& c) { listed.emplace_back(w, c); });
+            query.forEachNear(x, radius, 0.0, [&](int w, const WallContact& c) { whole.emplace_back(w, c); });
+            ASSERT_EQ(listed.size(), whole.size()) << "particle " << i << ", gap at build " << gapAtBuild[i];
+            for (std::size_t k = 0; k < whole.size(); ++k) {
+                EXPECT_EQ(listed[k].second.feature, whole[k].second.feature);
+                EXPECT_EQ(listed[k].second.overlap, whole[k].second.overlap);
+                EXPECT_EQ(listed[k].second.point, whole[k].second.point);
+            }
+            contacts += long(whole.size());
+            if (!whole.empty() && gapAtBuild[i] > skin) ++reachedByTheAllowance;
+        }
+    }
+    // Not vacuous: contacts, some of them of particles the skin alone would not have listed.
+    EXPECT_GT(contacts, 1000);
+    EXPECT_GT(reachedByTheAllowance, 20);
+}
+
+TEST(ParticleWallCandidates, SimulationFindsAMovingMeshThatWasOutOfReachAtTheBuild) {
+    // One sphere at rest without gravity never moves far enough to rebuild its
+    // neighbour list; a plate of triangles 4 mm below it rises at 2 m/s from
+    // the start (contact from 2 ms).  Out of reach at the build, the plate is
+    // found only because the wall lists are built again as it travels.
+    dem::WallMotion rise;
+    rise.addTranslation(0.0, 1.0, Vec3(0, 0, 2.0));
+    std::vector<Triangle> square = squareTriangles(0.02, 2);
+    for (Triangle& tri : square)
+        for (Vec3& v : tri) v -= Vec3(0.01, 0.01, 0.0);
+    dem::Simulation sim = sandWithoutGravity(
+        {{"plate", dem::MeshWall(std::make_shared<const dem::TriangleMesh>(square)), rise, 0}});
+    sim.insert({{Vec3(0, 0, 0.005), 0.001}}, 0, Vec3::Zero());
+    sim.step(1900);  // to 1.9 ms
+    EXPECT_EQ(sim.pairList().buildCount(), 1);
+    EXPECT_EQ(sim.particles().velocity[0].z(), 0.0);
+    sim.step(3100);  // to 5 ms
+    // Pushed ahead of the plate: at least its speed (about 1.5x it for e = 0.5).
+    EXPECT_GT(sim.particles().velocity[0].z(), 2.0);
 }

@@ -8,16 +8,36 @@
 namespace dem {
 
 void ParticleWallCandidates::build(const ParticleStore& particles, const std::vector<Wall>& walls, double time,
-                                   double reach) {
+                                   double reach, double travelAllowance) {
     const int n = static_cast<int>(particles.size());
     moving_.clear();
+    movingMeshes_.clear();
+    travelAllowance_ = travelAllowance;
     validUntil_ = std::numeric_limits<double>::infinity();
-    std::vector<int> fixed;  // at rest until validUntil_
+    double largestRadius = 0.0;
+    for (double r : particles.radius) largestRadius = std::max(largestRadius, r);
+    std::vector<int> listed;         // at rest, or a mesh, until validUntil_
+    std::vector<double> extraReach;  // per listed wall: the travel allowance of a moving mesh
     for (int w = 0; w < static_cast<int>(walls.size()); ++w) {
-        const WallMotion& motion = walls[w].motion;
-        if (motion.isMovingAt(time)) moving_.push_back(w);
-        else fixed.push_back(w);
+        const Wall& wall = walls[w];
+        const WallMotion& motion = wall.motion;
         validUntil_ = std::min(validUntil_, motion.nextChangeAfter(time));
+        if (!motion.isMovingAt(time)) {
+            listed.push_back(w);
+            extraReach.push_back(0.0);
+        } else if (wall.isMesh()) {
+            listed.push_back(w);
+            extraReach.push_back(travelAllowance);
+            const BoundingBox box = wall.referenceBoundingBox();
+            MovingMesh m;
+            m.wall = w;
+            m.pose = motion.at(time);
+            m.centre = 0.5 * (box.lower + box.upper);
+            m.radius = 0.5 * (box.upper - box.lower).norm() + largestRadius + reach + travelAllowance;
+            movingMeshes_.push_back(m);
+        } else {
+            moving_.push_back(w);
+        }
     }
     // Each thread lists a contiguous block of particles (static schedule), in
     // thread order: the blocks joined in that order are in particle order.
@@ -32,9 +52,10 @@ void ParticleWallCandidates::build(const ParticleStore& particles, const std::ve
         std::vector<WallContact> found;
 #pragma omp for schedule(static)
         for (int i = 0; i < n; ++i) {
-            for (int w : fixed) {
+            for (std::size_t k = 0; k < listed.size(); ++k) {
+                const int w = listed[k];
                 const Wall& wall = walls[w];
-                const double r = particles.radius[i] + reach;
+                const double r = particles.radius[i] + reach + extraReach[k];
                 if (!wall.boundingBox(time).overlapsSphere(particles.position[i], r)) continue;
                 const std::size_t before = mine.triangles.size();
                 if (wall.isMesh()) {
@@ -64,6 +85,19 @@ void ParticleWallCandidates::build(const ParticleStore& particles, const std::ve
         triangles_.insert(triangles_.end(), block.triangles.begin(), block.triangles.end());
     }
     for (int i = 0; i < n; ++i) offsets_[i + 1] += offsets_[i];
+}
+
+bool ParticleWallCandidates::movedTooFar(const std::vector<Wall>& walls, double time) const {
+    // A reference point y moves by (R - R0) y + (c - c0) between the poses; over
+    // the sphere |y - centre| <= radius that is at most
+    // |(R - R0) centre + c - c0| + ||R - R0|| radius (Frobenius >= spectral norm).
+    for (const MovingMesh& m : movingMeshes_) {
+        const RigidTransform now = walls[m.wall].motion.at(time);
+        const Mat3 turn = now.rotation - m.pose.rotation;
+        const double moved = (turn * m.centre + now.translation - m.pose.translation).norm() + turn.norm() * m.radius;
+        if (moved > travelAllowance_) return true;
+    }
+    return false;
 }
 
 }  // namespace dem

@@ -630,9 +630,11 @@ std::vector<double> Simulation::ownedWork() const {
 void Simulation::rebuildWallCandidates() {
     // A particle moves less than skin/2 from its position at the list build
     // before the next build, so walls farther than the skin (plus the bridge
-    // reach) from it now cannot touch it before then.
+    // reach) from it now cannot touch it before then.  A moving mesh wall is
+    // listed within a further skin/2, and the lists are built again when it
+    // has moved that far (computeForces).
     const double bridgeReach = settings_.forces.wallBridges ? wallContacts_.bridgeReach() : 0.0;
-    wallCandidates_.build(particles_, walls_, time_, pairs_.skin() + bridgeReach);
+    wallCandidates_.build(particles_, walls_, time_, pairs_.skin() + bridgeReach, 0.5 * pairs_.skin());
 }
 
 void Simulation::wallBridgeCandidates(double reach, std::vector<WallContactRecord>& records,
@@ -736,8 +738,9 @@ double Simulation::redistributeLiquid(double wallReach) {
 
 void Simulation::computeForces(bool forcesReset) {
     if (!forcesReset) resetForces(particles_, settings_.gravity);
-    // A wall starts or stops moving: the walls at rest are listed anew.
-    if (time_ >= wallCandidates_.validUntil()) rebuildWallCandidates();
+    // A wall starts or stops moving, or a moving mesh wall moved as far as its
+    // listing allows: the walls are listed anew.
+    if (time_ >= wallCandidates_.validUntil() || wallCandidates_.movedTooFar(walls_, time_)) rebuildWallCandidates();
     last_.contacts = kernel_->compute(particles_, pairs_, wallContacts_, walls_, wallCandidates_, interactions_,
                                       time_, settings_.timeStep);
     // With a decomposition a pair across a slab face breaks on both ranks: the

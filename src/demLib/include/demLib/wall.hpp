@@ -47,6 +47,10 @@ struct Wall {
     // planes, empty once removed).  A sphere whose box misses it has no
     // contact with this wall.
     BoundingBox boundingBox(double time) const;
+    // The shape's own box, in its reference frame (unbounded for a plane).
+    BoundingBox referenceBoundingBox() const {
+        return std::visit([](const auto& surface) { return surface.boundingBox(); }, shape);
+    }
     // Whether a point at `time` lies where no particle centre may be: behind
     // a plane (a one-sided boundary of the half-space in front of it) or
     // inside a closed mesh (a solid part).  A cylinder is a shell of no
