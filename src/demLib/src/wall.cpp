@@ -120,7 +120,7 @@ BoundingBox Wall::boundingBox(double time) const {
                                  cylinder->radius(), cylinder->zMin(), cylinder->zMax(), cylinder->side());
         return moved.boundingBox();
     }
-    return std::visit([&](const auto& surface) { return transformed(surface.boundingBox(), pose); }, shape);
+    return transformed(referenceBoundingBox(), pose);
 }
 
 bool Wall::enclosesPoint(const Vec3& point, double time) const {
