@@ -93,6 +93,10 @@ void FieldOutput::writeIndex() const {
           << precision << "\" Format=\"HDF\">" << e.file << ":/" << n << "</DataItem>\n    </Attribute>\n";
     };
     for (const Entry& e : entries_) {
+        // An output without particles stays in the series file but not in the
+        // index: ParaView 5.11's Xdmf Reader fails on an empty grid ("Failed to
+        // read data"), and one with no geometry crashes it (tests/paraview).
+        if (e.count == 0) continue;
         x << "   <Grid Name=\"step" << e.step << "\" GridType=\"Uniform\">\n"
           << "    <Time Value=\"" << e.time << "\"/>\n"
           << "    <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" << e.count << "\"/>\n"

@@ -11,8 +11,9 @@ namespace dem {
 
 class FieldOutput {
 public:
-    // Writes into `directory` (created if missing) as <baseName>_<step>.h5 and
-    // <baseName>.xdmf.  An existing index is continued: entries later than
+    // Writes into `directory` (created if missing) as <baseName>_<step>.h5,
+    // listed in <baseName>.series (every output) and <baseName>.xdmf (the
+    // outputs that hold particles: ParaView's index).  An existing index is continued: entries later than
     // `continueFromTime` are dropped from the index (a restarted run rewrites
     // them), earlier ones are kept.
     FieldOutput(std::string directory, std::string baseName = "particles",
