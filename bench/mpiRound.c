@@ -1,0 +1,45 @@
+/* The DEM step's exchange round between 2 MPI ranks, timed alone (docs/performance.md, "The wait
+ * is not the transport"): an MPI_Iallreduce of a flag, one MPI_Irecv/MPI_Isend pair of N bytes,
+ * MPI_Waitall, as demLib's Communicator::exchangeKnownSizesAndAnyTrue makes it each step.
+ *
+ *     mpicc -O2 bench/mpiRound.c -o /tmp/mpiRound
+ *     source etc/bashrc; diefill_mpirun -np 2 /tmp/mpiRound
+ *     diefill_mpirun -np 2 --mca btl_vader_eager_limit 65536 /tmp/mpiRound   # a transport setting
+ */
+#include <mpi.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+int main(int argc, char** argv) {
+    MPI_Init(&argc, &argv);
+    int rank, size;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &size);
+    if (size != 2) {
+        if (rank == 0) fprintf(stderr, "mpiRound: run on 2 ranks (mpirun -np 2), not %d\n", size);
+        MPI_Finalize();
+        return 2;
+    }
+    const int sizes[] = {64, 1024, 4096, 8192, 16384, 32768, 65536};
+    const int rounds = 20000;
+    char* out = calloc(65536, 1);
+    char* in = calloc(65536, 1);
+    for (int s = 0; s < 7; ++s) {
+        MPI_Barrier(MPI_COMM_WORLD);
+        const double start = MPI_Wtime();
+        for (int k = 0; k < rounds; ++k) {
+            MPI_Request requests[3];
+            long long mine = 0, any = 0;
+            MPI_Iallreduce(&mine, &any, 1, MPI_LONG_LONG, MPI_LOR, MPI_COMM_WORLD, &requests[0]);
+            MPI_Irecv(in, sizes[s], MPI_BYTE, 1 - rank, 7, MPI_COMM_WORLD, &requests[1]);
+            MPI_Isend(out, sizes[s], MPI_BYTE, 1 - rank, 7, MPI_COMM_WORLD, &requests[2]);
+            MPI_Waitall(3, requests, MPI_STATUSES_IGNORE);
+        }
+        const double seconds = MPI_Wtime() - start;
+        if (rank == 0) printf("%6d bytes: %.2f us per round\n", sizes[s], 1e6 * seconds / rounds);
+    }
+    free(out);
+    free(in);
+    MPI_Finalize();
+    return 0;
+}
