@@ -13,9 +13,9 @@ class FieldOutput {
 public:
     // Writes into `directory` (created if missing) as <baseName>_<step>.h5,
     // listed in <baseName>.series (every output) and <baseName>.xdmf (the
-    // outputs that hold particles: ParaView's index).  An existing index is continued: entries later than
-    // `continueFromTime` are dropped from the index (a restarted run rewrites
-    // them), earlier ones are kept.
+    // outputs that hold particles: ParaView's index).  An existing index is
+    // continued: entries later than `continueFromTime` are dropped from it (a
+    // restarted run rewrites them), earlier ones are kept.
     FieldOutput(std::string directory, std::string baseName = "particles",
                 double continueFromTime = -1.0);
 
