@@ -264,14 +264,15 @@ def test_restart():
     # a signal while a run is going: that run is not recorded and goes on next time
     sig = write_dict(os.path.join(TMP, "signal"), text)
     log = os.path.join(sig, "calls")
-    e = dict(os.environ, DIEFILL_DIR=ROOT, SYNTHETIC_CALLS=log, SYNTHETIC_SLEEP="1.5")
+    e = dict(os.environ, DIEFILL_DIR=ROOT, SYNTHETIC_CALLS=log, SYNTHETIC_SLEEP="3")
     p = subprocess.Popen([TOOL], cwd=sig, env=e, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     table = os.path.join(sig, "work", "plate", "runs.csv")
     deadline = time.time() + 60
-    while time.time() < deadline and len(calls(log)) < 3:     # run 3 has started (its sleep is 1.5 s)
+    while time.time() < deadline and len(calls(log)) < 3:     # run 3 has started (its sleep is 3 s)
         time.sleep(0.05)
-    time.sleep(0.3)
+    time.sleep(1.5)
     p.send_signal(signal.SIGTERM)
+    signalled = time.time()
     out, _ = p.communicate(timeout=60)
     n_after_stop = len(read_table(table))
     rc, out2, err2 = run_tool(sig, env={"SYNTHETIC_CALLS": log})
@@ -282,6 +283,20 @@ def test_restart():
           p.returncode == 4 and n_after_stop == 2 and rc == 0 and len(repeated) == 1
           and repeated.pop().endswith("run0003") and len(set(folders)) == len(rows),
           f"exit {p.returncode}, {n_after_stop} rows at the stop, then exit {rc}; calls {folders}; {out[-300:]}")
+    # the stopped run's 1.5 s before the stop count in its 'seconds' (continued, without the
+    # sleep, it takes well under that), and calls.csv / result.json's wallSeconds add up both calls
+    first_start = next(float(c[-1]) for c in calls(log) if c[0].endswith("run0003"))
+    run3 = next(r for r in rows if r["run"] == "3")
+    before = signalled - first_start
+    check("a run stopped and continued counts both calls' time in runs.csv's seconds",
+          float(run3["seconds"]) >= before - 0.05, f"{run3['seconds']} s; it ran {before:.2f} s before the stop")
+    calls_rows = read_table(os.path.join(sig, "work", "plate", "calls.csv"))
+    result = json.load(open(os.path.join(sig, "work", "plate", "result.json")))
+    total = sum(float(r["seconds"]) for r in calls_rows)
+    check("calls.csv: one row per call (stopped, then converged); result.json's wallSeconds is their sum",
+          [r["outcome"] for r in calls_rows] == ["stopped", "converged"]
+          and abs(result["wallSeconds"] - total) < 1e-9 and total >= before,
+          f"{calls_rows}, wallSeconds {result.get('wallSeconds')}")
 
     # the dictionary changed under the runs: refused, naming what changed
     changed = write_dict(os.path.join(TMP, "parts"), text.replace("(0.3 0.9)", "(0.3 0.8)"))

@@ -37,6 +37,7 @@ def summarise(runner, outcome, wall_seconds):
         "failedRuns": sum(r["status"] != "ok" for r in runner.table.rows),
         "simulationSeconds": float(sum(float(r["seconds"]) for r in runner.table.rows)),
         "wallSecondsThisCall": wall_seconds,
+        "wallSeconds": runner.wall_seconds(),       # every call on this stage (calls.csv)
         "chosenRun": int(rows[k]["run"]),
         "choose": s.choose,
         "start": {p.keyword: runner.start_values()[i] for i, p in enumerate(s.parameters)},

@@ -20,6 +20,7 @@ TABLE = "runs.csv"
 RECORD = "stage.json"
 RUN_PARAMETERS = "calibrationRun.json"
 RUN_LOG = "log.calibrationRun"
+CALLS = "calls.csv"      # one row per call of the tool on the stage: when, how long, how it ended
 # Results of an earlier run in the tutorial folder are not copied into a run's case.
 _NOT_COPIED = {"dem", "postProcessing", "runRecord", "setting", ".diefill.lock"}
 
@@ -209,7 +210,8 @@ class StageRunner:
         log.close()
         folder = self.run_folder(run_id)
         log_path = os.path.join(folder, RUN_LOG)
-        seconds = time.time() - start
+        # a run stopped and continued counts the time of its earlier calls too
+        seconds = time.time() - start + _seconds_before(folder)
         row = {"run": run_id}
         for p, u in zip(self.s.parameters, unit_point):
             row[p.keyword] = f"{p.from_unit(u):.10g}"
@@ -293,6 +295,7 @@ class StageRunner:
         'budget' or 'stopped' (stop_after runs finished in this call, or a signal)."""
         self.open()
         self.finished_here = 0
+        call_started = time.time()
         resume = self.resume_points()
         previous = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
 
@@ -338,6 +341,7 @@ class StageRunner:
                     process, start, point, log = self.running.pop(run_id)
                     if self.stopping and process.returncode != 0:
                         log.close()
+                        self._add_seconds_before(run_id, time.time() - start)
                         continue                       # stopped by us: continued next time, not recorded
                     row = self.collect(run_id, process, start, point, log)
                     self.finished_here += 1
@@ -347,14 +351,47 @@ class StageRunner:
                         if self.c.on_failure == "stop":
                             raise StopCalibration(f"stage '{self.s.name}': run {run_id} failed and onFailure is "
                                                   f"'stop': {row['message']}")
-        except BaseException:
+        except BaseException as e:
             self._stop_children(signal.SIGTERM)
-            for process, *_ in self.running.values():
+            for run_id, (process, start, *_) in list(self.running.items()):
                 process.wait()
+                self._add_seconds_before(run_id, time.time() - start)
+            outcome = f"error ({type(e).__name__})"
             raise
         finally:
             for s, h in previous.items():
                 signal.signal(s, h)
+            self._record_call(call_started, outcome or "stopped")
+
+    def _add_seconds_before(self, run_id, seconds):
+        """A run stopped before it finished: its time so far goes into its parameters file, so
+        that the table's 'seconds' of the run, once it finishes, counts every call's share."""
+        marker = os.path.join(self.run_folder(run_id), RUN_PARAMETERS)
+        try:
+            m = json.load(open(marker))
+        except (OSError, ValueError):
+            return
+        m["secondsBefore"] = float(m.get("secondsBefore", 0.0)) + seconds
+        _write_atomically(marker, json.dumps(m, indent=1))
+
+    def _record_call(self, started, outcome):
+        """Appends this call to calls.csv: the stage's wall time over interrupted calls."""
+        path = os.path.join(self.folder, CALLS)
+        ended = time.time()
+        new = not os.path.exists(path)
+        with open(path, "a", newline="") as f:
+            w = csv.writer(f)
+            if new:
+                w.writerow(["started", "ended", "seconds", "outcome", "runsFinished"])
+            w.writerow([_utc(started), _utc(ended), f"{ended - started:.1f}", outcome, self.finished_here])
+
+    def wall_seconds(self):
+        """The stage's wall time over every call recorded in calls.csv."""
+        path = os.path.join(self.folder, CALLS)
+        if not os.path.exists(path):
+            return 0.0
+        with open(path, newline="") as f:
+            return float(sum(float(r["seconds"]) for r in csv.DictReader(f)))
 
     def _wait(self):
         while True:
@@ -378,6 +415,17 @@ class StageRunner:
             text += f"; best so far run {best['run']} (misfit {float(best['misfit']):.3g})"
         text += f"; {float(row['seconds']):.0f} s; at most {_duration(eta)} left"
         _say(text)
+
+
+def _utc(t):
+    return time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime(t))
+
+
+def _seconds_before(folder):
+    try:
+        return float(json.load(open(os.path.join(folder, RUN_PARAMETERS))).get("secondsBefore", 0.0))
+    except (OSError, ValueError):
+        return 0.0
 
 
 def _duration(seconds):
