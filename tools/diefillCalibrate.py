@@ -45,9 +45,12 @@ Options:
   -report        write the results and plots from the runs made so far; run nothing
   -stopAfter N   stop once N runs have finished in this call (run again to continue)
 Exit status: 0 done (every stage converged), 1 bad input or a failed run with onFailure stop,
-3 a stage used up maxRuns and no run agrees with its targets, or a check stage does not agree
-(the later stages are not run),
+3 a stage used up maxRuns and no run agrees with its targets (the later stages are not run), or
+the last stage is a check that does not agree (a check followed by further stages that does not
+agree is reported and the later stages run: they may tune its case's parameters again),
 4 stopped (-stopAfter or a signal) before the end."""
+import datetime
+import json
 import os
 import sys
 import time
@@ -84,13 +87,19 @@ def main():
         print(f"diefillCalibrate: {a.dict} is fine; work folder {c.work_dir}")
         return 0
     carried = {}
+    summaries = []
     stop_after = a.stopAfter
     for s in c.stages:
         started = time.time()
         r = runner.StageRunner(c, s, dict(carried))
-        if carried:
+        tuned = {p.keyword for p in s.parameters}
+        kept = {k: v for k, v in carried.items() if k not in tuned}
+        if kept:
             print(f"{s.name}: kept fixed from the earlier stage(s): "
-                  + ", ".join(f"{k} {v:.4g}" for k, v in carried.items()), flush=True)
+                  + ", ".join(f"{k} {v:.4g}" for k, v in kept.items()), flush=True)
+        if len(kept) < len(carried):
+            print(f"{s.name}: tuned again, from the earlier stage(s)' values: "
+                  + ", ".join(f"{k} {v:.4g}" for k, v in carried.items() if k in tuned), flush=True)
         try:
             if a.report:
                 r.open()
@@ -118,10 +127,18 @@ def main():
         except ValueError as e:
             print(f"diefillCalibrate: error: {e}", file=sys.stderr)
             return 1
+        summaries.append(result)
         if not s.parameters:
             shown = ", ".join(f"{k} {v:.4g} (target {result['targets'][k]['value']:g} +- {result['targets'][k]['sigma']:g})"
                               for k, v in result["chosenTargets"].items())
             if not result["agrees"]:
+                if s is not c.stages[-1]:
+                    # The paper's order is one sweep of a fixed-point iteration: a later stage
+                    # may tune this case's parameters again with the others kept.
+                    print(f"{s.name}: check run at the earlier stages' values: {shown}: not within "
+                          f"{s.tolerance:g} sigma; the later stages go on", flush=True)
+                    continue
+                write_summary(c, summaries, carried, a.report)
                 print(f"diefillCalibrate: check stage '{s.name}': the case at the earlier stages' values gives {shown}: "
                       f"not within {s.tolerance:g} sigma (the later stage moved it; tune this case's parameters again "
                       f"in a further stage with the others kept)", file=sys.stderr)
@@ -146,7 +163,34 @@ def main():
                   f"{s.tolerance:g} sigma, the surrogate still expected some improvement (raise maxRuns to refine "
                   f"the posterior)", flush=True)
         carried.update(result["chosen"])
+    write_summary(c, summaries, carried, a.report)
     return 0
+
+
+def write_summary(c, summaries, values, reporting):
+    """WORKDIR/calibration.json (the values every stage leaves, and per stage its runs, times and
+    whether it agrees) and WORKDIR/demPropertiesFragment (those values, to paste)."""
+    whole = {
+        "values": values,
+        "runs": sum(r["runs"] for r in summaries),
+        "simulationSeconds": sum(r["simulationSeconds"] for r in summaries),
+        "wallSeconds": sum(r["wallSeconds"] for r in summaries),
+        "agrees": all(r["agrees"] for r in summaries[-1:]),
+        "stages": [{k: r[k] for k in ("stage", "setting", "outcome", "runs", "failedRuns", "simulationSeconds",
+                                      "wallSeconds", "chosen", "chosenTargets", "targets", "agrees")}
+                   for r in summaries],
+    }
+    runner._write_atomically(os.path.join(c.work_dir, "calibration.json"), json.dumps(whole, indent=1))
+    tuned_in = {k: r["stage"] for r in summaries for k in r["chosen"]}     # the last stage that tuned each
+    notes = {k: f"stage '{st}'" for k, st in tuned_in.items()}
+    header = [f"// diefillCalibrate, stages {', '.join(r['stage'] for r in summaries)} ({whole['runs']} runs, "
+              f"{datetime.date.today().isoformat()}): the values every stage leaves"]
+    runner._write_atomically(os.path.join(c.work_dir, "demPropertiesFragment"),
+                             report.values_text(values, notes, header))
+    if not reporting:
+        print(f"diefillCalibrate: {whole['runs']} runs, {whole['wallSeconds'] / 3600:.2f} h; the values of all "
+              f"stages in {os.path.join(c.work_dir, 'calibration.json')} and "
+              f"{os.path.join(c.work_dir, 'demPropertiesFragment')}", flush=True)
 
 
 if __name__ == "__main__":

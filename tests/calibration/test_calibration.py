@@ -356,12 +356,54 @@ stages
           rc == 0 and len(check_rows) == 1 and "check run" in out and "agrees" in out
           and abs(casefile.read_value(props, "interactions/sand-sand/friction") - mu) < 1e-9
           and abs(casefile.read_value(props, "interactions/sand-steel/friction") - muw) < 1e-9, f"{rc} {out[-300:]}")
+    whole = json.load(open(os.path.join(folder, "work", "calibration.json")))
+    check("calibration.json: the values of both stages, the runs of all three, the last check agrees",
+          abs(whole["values"]["interactions/sand-steel/friction"] - muw) < 1e-12
+          and abs(whole["values"]["interactions/sand-sand/friction"] - mu) < 1e-12
+          and whole["runs"] == plate["runs"] + repose["runs"] + 1 and whole["agrees"]
+          and [st["stage"] for st in whole["stages"]] == ["plate", "repose", "plateCheck"], whole)
+    check("WORKDIR/demPropertiesFragment holds both stages' values",
+          f"friction {muw:.4g};" in open(os.path.join(folder, "work", "demPropertiesFragment")).read()
+          and f"friction {mu:.4g};" in open(os.path.join(folder, "work", "demPropertiesFragment")).read())
     moved = write_dict(os.path.join(TMP, "two"), text.replace("value 26.2; sigma 0.3; } }\n    }\n}",
                                                                 "value 20; sigma 0.3; } }\n    }\n}"))
     shutil.rmtree(os.path.join(moved, "work", "plateCheck"))
     rc, out, err = run_tool(moved)
     check("check stage that does not agree: exit 3 naming the stage and the target", rc == 3
           and "plateCheck" in err and "angleAt50PercentSlid" in err and "not within" in err, f"{rc} {err[-300:]}")
+    # A check that disagrees and further stages: the paper's sweep once more.  The plate's target
+    # moved to 27 in the check and after it: the check disagrees, plateAgain tunes sand-steel
+    # friction again (sand-sand kept), reposeCheck runs the pile at the new pair.
+    again = write_dict(os.path.join(TMP, "again"), text.replace(
+        "targets { angleAt50PercentSlid { value 26.2; sigma 0.3; } }\n    }\n}",
+        """targets { angleAt50PercentSlid { value 27; sigma 0.3; } }
+    }
+    plateAgain
+    {
+        case "$DIEFILL_DIR/tests/calibration/syntheticCase";
+        parameters { interactions/sand-steel/friction (0.3 0.9); }
+        targets { angleAt50PercentSlid { value 27; sigma 0.3; } }
+    }
+    reposeCheck
+    {
+        case "$DIEFILL_DIR/tests/calibration/syntheticCase";
+        targets { reposeAngle { value 28; sigma 1.5; } }
+    }
+}"""))
+    rc, out, err = run_tool(again)
+    whole = json.load(open(os.path.join(again, "work", "calibration.json")))
+    muw2 = whole["values"]["interactions/sand-steel/friction"]
+    props = os.path.join(again, "work", "reposeCheck", "runs", "run0001", "constant", "demProperties")
+    check("a check that disagrees before further stages: reported, the later stages run, exit 0",
+          rc == 0 and "plateCheck: check run" in out and "later stages go on" in out
+          and "plateAgain: tuned again, from the earlier stage(s)' values: interactions/sand-steel/friction" in out
+          and "plateAgain: kept fixed from the earlier stage(s): interactions/sand-sand/friction" in out
+          and [st["stage"] for st in whole["stages"]] == ["plate", "repose", "plateCheck", "plateAgain", "reposeCheck"]
+          and not whole["stages"][2]["agrees"] and whole["agrees"], f"{rc} {err[-300:]}")
+    check("the re-tuning stage replaces the earlier sand-steel friction (27 deg: 0.5455) and the final check holds it",
+          abs(muw2 - (27 - 12 - 6 * 0.5) / 22) < 0.02
+          and abs(casefile.read_value(props, "interactions/sand-steel/friction") - muw2) < 1e-12
+          and abs(casefile.read_value(props, "interactions/sand-sand/friction") - mu) < 1e-12, f"{muw2} vs 0.5455")
     pngs = [p for p in ("response.png", "samples.png", "convergence.png")
             if os.path.getsize(os.path.join(folder, "work", "plate", p)) > 5000]
     check("plots written: response, samples, convergence", len(pngs) == 3, pngs)

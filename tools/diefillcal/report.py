@@ -86,20 +86,25 @@ def choose(runner, x, y):
 
 
 def fragment(result):
-    """The calibrated values as demProperties text, nested as their keyword paths."""
+    """A stage's calibrated values as demProperties text, nested as their keyword paths."""
+    notes = {k: f"posterior {p['mean']:.4g} +- {p['std']:.2g}" for k, p in result["posterior"].items()}
+    header = (f"// diefillCalibrate, stage '{result['stage']}' ({result['setting']} setting, "
+              f"{result['runs']} runs, {datetime.date.today().isoformat()}): run {result['chosenRun']}, "
+              + ", ".join(f"{k} {v:.4g}" for k, v in result["chosenTargets"].items())
+              + " (targets: " + ", ".join(f"{k} {t['value']:g} +- {t['sigma']:g}" for k, t in result["targets"].items()) + ")")
+    return values_text(result["chosen"], notes, [header])
+
+
+def values_text(values, notes, header):
+    """Keyword-path values as nested demProperties text, each with its note as a comment."""
     tree = {}
-    for keyword, value in result["chosen"].items():
+    for keyword, value in values.items():
         node = tree
         names = keyword.split("/")
         for n in names[:-1]:
             node = node.setdefault(n, {})
-        post = result["posterior"][keyword]
-        node[names[-1]] = (value, f"posterior {post['mean']:.4g} +- {post['std']:.2g}")
-    lines = [f"// diefillCalibrate, stage '{result['stage']}' ({result['setting']} setting, "
-             f"{result['runs']} runs, {datetime.date.today().isoformat()}): run {result['chosenRun']}, "
-             + ", ".join(f"{k} {v:.4g}" for k, v in result["chosenTargets"].items())
-             + " (targets: " + ", ".join(f"{k} {t['value']:g} +- {t['sigma']:g}" for k, t in result["targets"].items()) + ")",
-             "// Paste into constant/demProperties (the entries replace the ones of the same names)."]
+        node[names[-1]] = (value, notes.get(keyword, ""))
+    lines = list(header) + ["// Paste into constant/demProperties (the entries replace the ones of the same names)."]
 
     def write(node, indent):
         for name, value in node.items():
