@@ -25,6 +25,7 @@ DICT (default ./calibrationDict) is an OpenFOAM-style dictionary:
             targets    { angleAt50PercentSlid { value 29; sigma 1.5; } }   // keys of postProcessing/results.json
             initialRuns 4;  minRuns 5;  maxRuns 16;  tolerance 1;  eiTolerance 0.01;   // optional
             choose     nearest;   // of the runs that agree, the one nearest the case's values (or: best)
+            nearestRuns 2;        // runs at the surrogate's agreeing point nearest the case's values
             startRun   yes;       // the first run at the case's own values (no: the design only)
         }
     }

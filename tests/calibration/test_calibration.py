@@ -191,6 +191,8 @@ def test_errors():
     expect_error("restitution above one",
                  one_stage().replace("sand-steel/friction (0.3 0.9)", "sand-steel/restitution (0.1 1.2)"),
                  ["interactions/sand-steel/restitution", "1.2", "(0, 1]"])
+    expect_error("nearestRuns with choose best", one_stage(extra="choose best; nearestRuns 2;"),
+                 ["nearestRuns", "choose best", "expected 0"])
     expect_error("range upside down", one_stage().replace("(0.3 0.9)", "(0.9 0.3)"), ["LOW < HIGH"])
     expect_error("sigma zero", one_stage(sigma=0), ["sigma", "at least"])
     expect_error("setting not quick/full", one_stage(extra="setting medium;"), ["setting", "quick, full"])
@@ -376,20 +378,9 @@ stages
     # friction again (sand-sand kept), reposeCheck runs the pile at the new pair.
     again = write_dict(os.path.join(TMP, "again"), text.replace(
         "targets { angleAt50PercentSlid { value 26.2; sigma 0.3; } }\n    }\n}",
-        """targets { angleAt50PercentSlid { value 27; sigma 0.3; } }
-    }
-    plateAgain
-    {
-        case "$DIEFILL_DIR/tests/calibration/syntheticCase";
-        parameters { interactions/sand-steel/friction (0.3 0.9); }
-        targets { angleAt50PercentSlid { value 27; sigma 0.3; } }
-    }
-    reposeCheck
-    {
-        case "$DIEFILL_DIR/tests/calibration/syntheticCase";
-        targets { reposeAngle { value 28; sigma 1.5; } }
-    }
-}"""))
+        "targets { angleAt50PercentSlid { value 27; sigma 0.3; } }\n    }\n"
+        + synthetic_stage("plateAgain", "angleAt50PercentSlid", 27, 0.3, "interactions/sand-steel/friction")
+        + synthetic_stage("reposeCheck", "reposeAngle", 28, 1.5) + "}"))
     rc, out, err = run_tool(again)
     whole = json.load(open(os.path.join(again, "work", "calibration.json")))
     muw2 = whole["values"]["interactions/sand-steel/friction"]
@@ -409,26 +400,38 @@ stages
     check("plots written: response, samples, convergence", len(pngs) == 3, pngs)
 
 
+def synthetic_stage(name, target, value, sigma, parameter=None):
+    """A stage of the synthetic case as dictionary text: one target, one parameter (0.3-0.9) or none."""
+    tuned = f"        parameters {{ {parameter} (0.3 0.9); }}\n" if parameter else ""
+    return (f"    {name}\n    {{\n        case \"$DIEFILL_DIR/tests/calibration/syntheticCase\";\n{tuned}"
+            f"        targets {{ {target} {{ value {value:g}; sigma {sigma:g}; }} }}\n    }}\n")
+
+
+def ridge_dict(value, sigma, max_runs, extra):
+    """One stage, two sand-steel parameters, one plate target: the agreeing values lie on the
+    ridge 12 + 22 muW + 6 murW = value."""
+    return f'''workDir work;
+stages
+{{
+    plate
+    {{
+        case "$DIEFILL_DIR/tests/calibration/syntheticCase";
+        parameters {{ interactions/sand-steel/friction (0.3 0.9); interactions/sand-steel/rollingFriction (0.1 0.9); }}
+        targets {{ angleAt50PercentSlid {{ value {value:g}; sigma {sigma:g}; }} }}
+        maxRuns {max_runs};
+        {extra}
+    }}
+}}
+'''
+
+
 def test_choose():
     # one target, two parameters: the agreeing runs lie on a ridge (12 + 22 muW + 6 murW = 26.2)
-    text = '''workDir work;
-stages
-{
-    plate
-    {
-        case "$DIEFILL_DIR/tests/calibration/syntheticCase";
-        parameters { interactions/sand-steel/friction (0.3 0.9); interactions/sand-steel/rollingFriction (0.1 0.9); }
-        targets { angleAt50PercentSlid { value 26.2; sigma 1.0; } }
-        maxRuns 10;
-        CHOOSE
-    }
-}
-'''
     start = np.array([0.61, 0.50])                # the synthetic case's own values
     width = np.array([0.6, 0.8])
     out = {}
     for rule in ("best", "nearest"):
-        folder = write_dict(os.path.join(TMP, "choose-" + rule), text.replace("CHOOSE", f"choose {rule};"))
+        folder = write_dict(os.path.join(TMP, "choose-" + rule), ridge_dict(26.2, 1.0, 10, f"choose {rule};"))
         rc, _, err = run_tool(folder)
         r = json.load(open(os.path.join(folder, "work", "plate", "result.json")))
         rows = [row for row in read_table(os.path.join(folder, "work", "plate", "runs.csv")) if row["status"] == "ok"]
@@ -445,6 +448,33 @@ stages
     check("choose best: the run of smallest misfit (an agreeing one at least as far from the start as nearest's)",
           rc_b == 0 and r_b["chosenMisfit"] <= r["chosenMisfit"] + 1e-12
           and float(np.linalg.norm((chosen_b - start) / width)) >= min(distances) - 1e-9, f"{chosen_b} {r_b['chosenMisfit']}")
+
+
+def test_nearest_runs():
+    # A ridge the case's own values miss (12 + 22 muW + 6 murW = 27: (0.61, 0.50) gives 28.4):
+    # the ridge's point nearest them lies 0.101 of the ranges away (agreeing within 0.036 of
+    # it).  The expected-improvement runs stop anywhere on the ridge; the nearest-agreeing run
+    # must bring the chosen values near the case's.
+    start = np.array([(0.61 - 0.3) / 0.6, (0.50 - 0.1) / 0.8])
+    found = {}
+    for runs in (0, 2):
+        folder = write_dict(os.path.join(TMP, f"nearest-{runs}"), ridge_dict(27, 0.5, 16, f"nearestRuns {runs};"))
+        rc, out, err = run_tool(folder)
+        r = json.load(open(os.path.join(folder, "work", "plate", "result.json")))
+        chosen = np.array([(r["chosen"]["interactions/sand-steel/friction"] - 0.3) / 0.6,
+                           (r["chosen"]["interactions/sand-steel/rollingFriction"] - 0.1) / 0.8])
+        whys = [json.load(open(os.path.join(folder, "work", "plate", "runs", n, "calibrationRun.json")))["why"]
+                for n in sorted(os.listdir(os.path.join(folder, "work", "plate", "runs")))]
+        found[runs] = (rc, float(np.linalg.norm(chosen - start)), whys, r, out)
+    rc, d0, whys0, r0, _ = found[0]
+    rc2, d2, whys2, r2, out2 = found[2]
+    check(f"nearestRuns 0: converges on the ridge, chosen {d0:.3f} of the ranges from the case's values "
+          f"(the ridge's nearest agreeing point: 0.065-0.137)", rc == 0 and r0["agrees"], f"{rc} {whys0}")
+    check(f"nearestRuns 2 (the default): a run at the surrogate's nearest agreeing point is made and chosen: "
+          f"{d2:.3f} of the ranges from the case's values, at most 0.137 (without: {d0:.3f})",
+          rc2 == 0 and r2["agrees"] and "nearest agreeing point" in whys2 and d2 <= 0.137 and d2 < d0,
+          f"{rc2} {whys2} {out2[-400:]}")
+    check("nearestRuns: at most 2 such runs", whys2.count("nearest agreeing point") <= 2, whys2)
 
 
 def test_start_run():
@@ -526,7 +556,7 @@ stages
 
 if __name__ == "__main__":
     quick_only = "-quickOnly" in sys.argv
-    tests = [test_method, test_casefile, test_errors, test_restart, test_two_stages, test_choose, test_start_run, test_parallel]
+    tests = [test_method, test_casefile, test_errors, test_restart, test_two_stages, test_choose, test_nearest_runs, test_start_run, test_parallel]
     if "-endToEnd" in sys.argv:
         tests.append(test_end_to_end)
     try:

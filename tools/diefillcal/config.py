@@ -51,6 +51,7 @@ class Stage:
         self.tolerance = 1.0
         self.ei_tolerance = 0.01
         self.choose = "nearest"
+        self.nearest_runs = 0
         self.start_run = True
 
     @property
@@ -164,7 +165,7 @@ def read(path, work_dir=None):
 def _read_stage(name, sd, where, base):
     s = Stage(name)
     _unknown_keys(sd, ["case", "setting", "allrunOptions", "fixed", "parameters", "targets", "initialRuns",
-                       "minRuns", "maxRuns", "tolerance", "eiTolerance", "choose", "startRun"], where)
+                       "minRuns", "maxRuns", "tolerance", "eiTolerance", "choose", "startRun", "nearestRuns"], where)
     if "case" not in sd:
         raise InputError(f"{where}: keyword 'case' is missing; expected the folder of a case with an Allrun (a tutorial)")
     case = os.path.expandvars(str(sd["case"]))
@@ -239,6 +240,10 @@ def _read_stage(name, sd, where, base):
     s.tolerance = _number(sd, "tolerance", where, 1.0, 1e-6)
     s.ei_tolerance = _number(sd, "eiTolerance", where, 0.01, 0.0)
     s.choose = _word(sd, "choose", where, ("nearest", "best"), "nearest")
+    s.nearest_runs = _number(sd, "nearestRuns", where, 2 if s.choose == "nearest" else 0, 0, None, True)
+    if s.nearest_runs and s.choose != "nearest":
+        raise InputError(f"{where}: keyword 'nearestRuns' is {s.nearest_runs} with 'choose best'; expected 0, "
+                         f"or 'choose nearest' (the runs are made to find the agreeing values nearest the case's)")
     return s
 
 

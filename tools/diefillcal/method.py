@@ -178,6 +178,28 @@ def propose(surrogate, x_done, best_misfit, count, avoid=(), seed=0, candidates=
     return np.array(chosen), eis
 
 
+def nearest_agreeing(surrogate, start, tolerance, seed=0, candidates=8192):
+    """The unit point nearest `start` where the surrogate is sure enough of agreement: every
+    target's predicted mean within half of tolerance x sigma of its value, and its predictive
+    sd (the simulations' scatter included) under half of tolerance x sigma, so that a run there
+    is likely to agree.  Candidates: a Sobol sample and points spread around `start`.  Returns
+    the point, or None when no candidate qualifies."""
+    dim = surrogate.dim
+    start = np.asarray(start, float)
+    rng = np.random.default_rng(seed)
+    pool = np.vstack([stats.qmc.Sobol(d=dim, seed=seed).random(candidates),
+                      np.clip(start + rng.normal(0.0, 0.15, (candidates // 2, dim)), 0.0, 1.0)])
+    mean, var = surrogate.predict(pool)
+    scatter = np.array([m.noise_variance for m in surrogate.models])
+    half = 0.5 * tolerance * surrogate.sigmas
+    sure = np.all((np.abs(mean - surrogate.targets) <= half) & (np.sqrt(var + scatter) <= half), axis=1)
+    if not np.any(sure):
+        return None
+    distance = np.sum((pool - start) ** 2, axis=1)
+    distance[~sure] = np.inf
+    return pool[int(np.argmin(distance))]
+
+
 def posterior(surrogate, rounds=3, n=8192, seed=0):
     """Weighted samples of the posterior over the unit cube (uniform prior), from the
     surrogate's likelihood: mean, standard deviation and 2.5/97.5 % quantiles per parameter,

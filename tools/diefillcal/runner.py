@@ -158,6 +158,16 @@ class StageRunner:
             return stats.qmc.Sobol(d=d, seed=self.c.seed + 1).random(64)[run_id % 64], "space-filling"
         s = self.surrogate(x, y)
         pending = np.array([r[2] for r in self.running.values()]).reshape(-1, d)
+        if self.converged_apart_from_nearest(x, y, s):
+            # Only the nearest-agreeing run is left to make (one at a time: its result decides
+            # whether another is worth it).
+            if any(self._marker_why(r) == self.NEAREST for r in self.running):
+                return None, None
+            q = self.nearest_point(x, y, s, pending)
+            if q is not None:
+                return q, self.NEAREST
+            if len(pending):
+                return None, None
         s = s.believe(pending)
         best = min(self.misfit(v) for v in y)
         done = np.vstack([x, pending, self._failed_points()]) if len(pending) else np.vstack([x, self._failed_points()])
@@ -267,7 +277,8 @@ class StageRunner:
         point promises an improvement of the misfit above eiTolerance, or above what the
         simulations' own scatter makes of the misfit (sum of the fitted scatter^2 / sigma^2: a DEM
         result moves by a fraction of a degree under a small change of the inputs, and a smaller
-        improvement could not be told from it)."""
+        improvement could not be told from it); with 'choose nearest', also not while
+        nearest_point() offers a run nearer the case's values than every run that agrees."""
         rows, x, y = self.finished_ok()
         if not rows:
             return False, False, None, None
@@ -278,10 +289,67 @@ class StageRunner:
         if len(rows) < 2 or len(self.table.rows) < self.s.min_runs:
             return False, agrees, None, None
         s = self.surrogate(x, y)
-        _, ei = method.propose(s, np.vstack([x, self._failed_points()]), self.misfit(y[k]), 1,
+        settled, ei, scatter_floor = self._settling(x, y, s)
+        if settled and self.nearest_point(x, y, s) is not None:
+            settled = False             # a run nearer the case's values first (choose nearest)
+        return settled, agrees, ei, scatter_floor
+
+    def _settling(self, x, y, surrogate):
+        """(settled, largest expected improvement, scatter floor): the best run agrees and no
+        point promises more than eiTolerance or the scatter floor."""
+        misfits = [self.misfit(v) for v in y]
+        k = int(np.argmin(misfits))
+        agrees = all(abs(v - t.value) <= self.s.tolerance * t.sigma for v, t in zip(y[k], self.s.targets))
+        _, ei = method.propose(surrogate, np.vstack([x, self._failed_points()]), misfits[k], 1,
                                avoid=self._failed_points(), seed=self.c.seed)
-        scatter_floor = float(sum(m.noise_variance / t.sigma ** 2 for m, t in zip(s.models, self.s.targets)))
-        return agrees and ei[0] < max(self.s.ei_tolerance, scatter_floor), agrees, ei[0], scatter_floor
+        floor = float(sum(m.noise_variance / t.sigma ** 2 for m, t in zip(surrogate.models, self.s.targets)))
+        return agrees and ei[0] < max(self.s.ei_tolerance, floor), ei[0], floor
+
+    NEAREST = "nearest agreeing point"
+
+    def nearest_point(self, x, y, surrogate, pending=()):
+        """With 'choose nearest': the unit point nearest the case's own values where the surrogate
+        expects agreement, when it lies nearer than every run that agrees (by at least 0.05 of the
+        ranges) and away from the runs made and running; None otherwise, or once nearestRuns such
+        runs have been started.  On a ridge of agreeing values (fewer targets than parameters)
+        the expected-improvement proposals may explore only one end of it; this run tries the
+        ridge's point nearest the given values."""
+        if self.s.choose != "nearest" or not self.s.parameters or len(self._runs_started_as(self.NEAREST)) >= self.s.nearest_runs:
+            return None
+        start = np.array([p.to_unit(v) for p, v in zip(self.s.parameters, self.start_values())])
+        agree = [i for i in range(len(y)) if all(abs(y[i, j] - t.value) <= self.s.tolerance * t.sigma
+                                                  for j, t in enumerate(self.s.targets))]
+        nearest_run = min((float(np.sqrt(np.sum((x[i] - start) ** 2))) for i in agree), default=np.inf)
+        q = method.nearest_agreeing(surrogate, start, self.s.tolerance, seed=self.c.seed)
+        if q is None or float(np.sqrt(np.sum((q - start) ** 2))) > nearest_run - 0.05:
+            return None
+        made = np.vstack([x, self._failed_points()] + ([np.asarray(pending).reshape(-1, len(start))] if len(pending) else []))
+        if len(made) and float(np.sqrt(((made - q) ** 2).sum(1)).min()) < 0.02:
+            return None
+        return q
+
+    def converged_apart_from_nearest(self, x, y, surrogate):
+        """converged()'s test without the nearest-agreeing run."""
+        return len(self.table.rows) >= self.s.min_runs and self._settling(x, y, surrogate)[0]
+
+    def _marker_why(self, run_id):
+        try:
+            return json.load(open(os.path.join(self.run_folder(run_id), RUN_PARAMETERS))).get("why")
+        except (OSError, ValueError):
+            return None
+
+    def _runs_started_as(self, why):
+        """Ids of the runs (finished or not) whose parameters file gives `why` as the reason."""
+        out = []
+        runs = os.path.join(self.folder, "runs")
+        for name in sorted(os.listdir(runs)) if os.path.isdir(runs) else []:
+            try:
+                m = json.load(open(os.path.join(runs, name, RUN_PARAMETERS)))
+            except (OSError, ValueError):
+                continue
+            if m.get("why") == why:
+                out.append(int(m["run"]))
+        return out
 
     def _stop_children(self, signum):
         for process, *_ in self.running.values():
@@ -330,6 +398,8 @@ class StageRunner:
                             missing = [i for i in range(1, self.s.first_runs + 1) if i not in used]
                             run_id = missing[0] if missing else max(used | {0}) + 1
                             point, why = self.next_point(run_id)
+                            if point is None:       # only a run that waits on a running one is left
+                                break
                         if self.stopping:           # a signal came while the point was chosen
                             break
                         self.launch(run_id, point, why)
