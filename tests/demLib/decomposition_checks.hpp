@@ -315,6 +315,41 @@ inline std::size_t straddlingBridges(const dem::Simulation& sim) {
 // run's bridges (count, liquid per weight, hence forces) at every list build,
 // conserves the liquid to 1e-12 summed over ranks, and follows the serial
 // trajectories through rebuilds, migrations, broken bridges and losses.
+// Steps both runs `steps` times; the number of steps after which a particle
+// was owned twice or by none, or the bridges and the pool did not hold `total`.
+inline std::int64_t wetStepsGoneWrong(const dem::Communicator& comm, Runs& runs, long steps, double total) {
+    std::int64_t badSteps = 0;
+    for (long s = 0; s < steps; ++s) {
+        runs.serial.step(1);
+        runs.decomposed.step(1);
+        if (!ownedOnceEach(comm, runs.serial, runs.decomposed)) ++badSteps;
+        // The water of the run, held by the bridges of all ranks and the pool
+        const double held = runs.decomposed.liquidInBridges();
+        if (!(std::abs(held + runs.decomposed.liquidOverRanks().poolVolume - total) <= 1e-12 * total)) ++badSteps;
+    }
+    return badSteps;
+}
+
+// The largest distance, over ranks, of an owned particle from the same id in
+// the serial run; `unknown` counts owned ids the serial run does not hold.
+inline double positionErrorFromSerial(const dem::Communicator& comm, const Runs& runs, std::int64_t& unknown) {
+    const dem::ParticleStore& ref = runs.serial.particles();
+    const dem::ParticleStore& p = runs.decomposed.particles();
+    const std::vector<long> index = indexById(ref, static_cast<std::size_t>(runs.serial.nextId()));
+    double xError = 0.0;
+    unknown = 0;
+    for (std::size_t i = 0; i < runs.decomposed.ownedCount(); ++i) {
+        const long k = index[static_cast<std::size_t>(p.id[i])];
+        if (k < 0) {
+            ++unknown;
+            continue;
+        }
+        xError = std::max(xError, (p.position[i] - ref.position[k]).norm());
+    }
+    unknown = comm.sum(unknown);
+    return comm.max(xError);
+}
+
 inline void wetRunSharesTheSerialLiquid(const dem::Communicator& comm) {
     const Case c = wetGas();
     const auto runs = start(comm, c, 0.3);
@@ -339,31 +374,11 @@ inline void wetRunSharesTheSerialLiquid(const dem::Communicator& comm) {
     expectLoadsMatch(comm, *runs, "wet, after 1 step");
 
     const long steps = 400;
-    std::int64_t badSteps = 0;
-    for (long s = 0; s < steps; ++s) {
-        runs->serial.step(1);
-        runs->decomposed.step(1);
-        if (!ownedOnceEach(comm, runs->serial, runs->decomposed)) ++badSteps;
-        // The water of the run, held by the bridges of all ranks and the pool
-        const double held = runs->decomposed.liquidInBridges();
-        if (!(std::abs(held + runs->decomposed.liquidOverRanks().poolVolume - total) <= 1e-12 * total)) ++badSteps;
-    }
-    EXPECT_EQ(badSteps, 0) << "steps after which a particle was owned twice or by none, or the liquid not conserved";
-    const dem::ParticleStore& ref = runs->serial.particles();
-    const dem::ParticleStore& p = runs->decomposed.particles();
-    const std::vector<long> index = indexById(ref, static_cast<std::size_t>(runs->serial.nextId()));
-    double xError = 0.0;
+    EXPECT_EQ(wetStepsGoneWrong(comm, *runs, steps, total), 0)
+        << "steps after which a particle was owned twice or by none, or the liquid not conserved";
     std::int64_t unknown = 0;
-    for (std::size_t i = 0; i < runs->decomposed.ownedCount(); ++i) {
-        const long k = index[static_cast<std::size_t>(p.id[i])];
-        if (k < 0) {
-            ++unknown;
-            continue;
-        }
-        xError = std::max(xError, (p.position[i] - ref.position[k]).norm());
-    }
-    xError = comm.max(xError);
-    EXPECT_EQ(comm.sum(unknown), 0);
+    const double xError = positionErrorFromSerial(comm, *runs, unknown);
+    EXPECT_EQ(unknown, 0);
     EXPECT_LE(xError, 1e-9) << "largest position deviation from the serial run [m]";
     const dem::LiquidState serialEnd = runs->serial.liquid();
     const dem::LiquidState mineEnd = runs->decomposed.liquidOverRanks();
@@ -381,6 +396,34 @@ inline void wetRunSharesTheSerialLiquid(const dem::Communicator& comm) {
                     steps + 1, xError, mineEnd.bridgeCount, static_cast<long>(straddling), mineEnd.wallBridgeCount,
                     held, total, mineEnd.poolVolume, runs->serial.lostCount(),
                     runs->decomposed.pairList().buildCount());
+}
+
+// The wet gas with radii from 0.5 to 1 mm: a ghost is sent out to its own
+// radius + r_max + skin + bridge reach from another slab (a small particle
+// less far than a large one); the run still follows the serial one, owns each
+// particle once, keeps its water and forms the same bridges.
+inline void polydisperseWetRunFollowsTheSerialRun(const dem::Communicator& comm) {
+    Case c = wetGas();
+    std::mt19937 rng(31);
+    std::uniform_real_distribution<double> radius(0.5e-3, 1.0e-3);
+    for (dem::InsertedParticle& q : c.particles) q.radius = radius(rng);
+    const auto runs = start(comm, c, 0.3);
+    runs->serial.step(1);
+    runs->decomposed.step(1);
+    const double total = runs->serial.liquid().totalVolume;
+    expectLoadsMatch(comm, *runs, "polydisperse wet, after 1 step");
+    EXPECT_EQ(wetStepsGoneWrong(comm, *runs, 400, total), 0)
+        << "steps after which a particle was owned twice or by none, or the liquid not conserved";
+    std::int64_t unknown = 0;
+    const double xError = positionErrorFromSerial(comm, *runs, unknown);
+    EXPECT_EQ(unknown, 0);
+    EXPECT_LE(xError, 1e-9) << "largest position deviation from the serial run [m]";
+    EXPECT_GT(runs->serial.liquid().bridgeCount, 50u);
+    EXPECT_EQ(runs->decomposed.liquidOverRanks().bridgeCount, runs->serial.liquid().bridgeCount);
+    EXPECT_GT(runs->serial.pairList().buildCount(), 5);
+    if (comm.rank() == 0)
+        std::printf("polydisperse wet, 401 steps: position error %.3e m; %zu bridges; %ld list builds\n", xError,
+                    runs->serial.liquid().bridgeCount, runs->decomposed.pairList().buildCount());
 }
 
 }  // namespace decomposition_checks

@@ -414,6 +414,24 @@ TEST(LiquidBridges, IndependentOfCandidateOrder) {
     }
 }
 
+TEST(LiquidBridges, APairRanksTheSameWhicheverParticleIsFirst) {
+    // A pair across a slab face is a candidate on both ranks, each with its own
+    // particle first; the cut of the ranking needs the same λ* bits from both.
+    std::mt19937_64 random(7);
+    std::uniform_real_distribution<double> radius(0.2e-3, 1.3e-3), gap(0.0, 0.3e-3);
+    const dem::LiquidBridgeSettings settings;
+    int differentWithTheGapSubtractedInTurn = 0;
+    for (int k = 0; k < 20000; ++k) {
+        const double a = radius(random), b = radius(random), d = a + b + gap(random);
+        const double ab = dem::bridgeStabilityThreshold(a, b, d, settings);
+        const double ba = dem::bridgeStabilityThreshold(b, a, d, settings);
+        ASSERT_EQ(ab, ba) << "radii " << a << ", " << b << ", centre distance " << d;
+        if ((d - a) - b != (d - b) - a) ++differentWithTheGapSubtractedInTurn;
+    }
+    // The control: subtracting the radii one after the other depends on the order.
+    EXPECT_GT(differentWithTheGapSubtractedInTurn, 1000);
+}
+
 TEST(LiquidBridges, CoordinationNumberAndWaterVolume) {
     EXPECT_EQ(dem::liquidCoordinationNumber(400, 100), 8.0);
     EXPECT_EQ(dem::liquidCoordinationNumber(0, 0), 0.0);

@@ -495,4 +495,31 @@ TEST(ThreadRanks, MultiStepRunFollowsTheSerialRun) {
         dem::Communicator::runThreadGroup(ranks, decomposition_checks::multiStepRunFollowsTheSerialRun);
 }
 
+TEST(ThreadRanks, PolydisperseWetRunFollowsTheSerialRun) {
+    for (int ranks : {2, 3})
+        dem::Communicator::runThreadGroup(ranks, decomposition_checks::polydisperseWetRunFollowsTheSerialRun);
+}
+
+TEST(ThreadRanks, AGhostGoesAsFarAsItsOwnRadiusAllowsAPair) {
+    // Slabs cut at x = 0.5; rank 0 owns a small (r = 0.1) and a large (r = 0.3)
+    // particle, both 0.45 from rank 1's slab.  With r_max + skin + reach = 0.3
+    // a pair with rank 1 needs a centre within r_i + 0.3 of its slab: the
+    // large one (0.6) is a ghost there, the small one (0.4) cannot touch anything.
+    dem::Communicator::runThreadGroup(2, [](const dem::Communicator& c) {
+        dem::GhostExchange exchange(c, dem::SlabDecomposition(2, 0, {0.5}));
+        dem::ParticleStore p;
+        if (c.rank() == 0) {
+            p.add(1, Vec3(0.05, 0.0, 0.0), Vec3::Zero(), 0.1, 2500.0, 0);
+            p.add(2, Vec3(0.05, 1.0, 0.0), Vec3::Zero(), 0.3, 2500.0, 0);
+        }
+        exchange.appendGhosts(p, 0.3);
+        if (c.rank() == 1) {
+            ASSERT_EQ(exchange.ghostCount(), 1u);
+            EXPECT_EQ(p.id[0], 2);
+        } else {
+            EXPECT_EQ(exchange.ghostCount(), 0u);
+        }
+    });
+}
+
 }  // namespace

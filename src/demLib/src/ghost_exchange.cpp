@@ -311,20 +311,21 @@ std::size_t GhostExchange::migrate(ParticleStore& p) {
     return left;
 }
 
-void GhostExchange::appendGhosts(ParticleStore& p, double haloWidth) {
+void GhostExchange::appendGhosts(ParticleStore& p, double reachBeyondRadius) {
     if (ghostCount_ != 0) throw RuntimeError("demLib ghost exchange: appendGhosts() called with ghosts present");
     const int ranks = communicator_.size();
     const int me = rank();
     const std::size_t owned = p.size();
-    // A pair closer than haloWidth has both centres within haloWidth of the
-    // other's slab; the margin only adds ghosts, never removes needed ones.
-    const double reach = haloWidth * (1.0 + 1e-9);
+    // A pair i-j is closer than r_i + r_j + skin + extra <= r_i + reachBeyondRadius
+    // (= r_max + skin + extra), so i lies that close to j's slab; a small
+    // particle need not go as far as a large one.  The margin only adds ghosts.
     std::vector<std::vector<char>> send(ranks);
     for (int r = 0; r < ranks; ++r) {
         sendList_[r].clear();
         if (r == me) continue;
         for (std::size_t i = 0; i < owned; ++i)
-            if (slabs_.distanceToSlab(r, p.position[i]) < reach) sendList_[r].push_back(static_cast<int>(i));
+            if (slabs_.distanceToSlab(r, p.position[i]) < (p.radius[i] + reachBeyondRadius) * (1.0 + 1e-9))
+                sendList_[r].push_back(static_cast<int>(i));
         ByteWriter w{send[r]};
         for (int i : sendList_[r]) packParticle(w, p, static_cast<std::size_t>(i));
     }

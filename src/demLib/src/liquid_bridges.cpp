@@ -71,7 +71,7 @@ double bridgeStabilityThreshold(double gap, double weight, double contactAngle) 
 
 double bridgeStabilityThreshold(double radiusOfA, double radiusOfB, double distanceOfCentres,
                                 const LiquidBridgeSettings& settings) {
-    return bridgeStabilityThreshold(distanceOfCentres - radiusOfA - radiusOfB,
+    return bridgeStabilityThreshold(distanceOfCentres - (radiusOfA + radiusOfB),
                                     bridgeVolumeWeight(radiusOfA, radiusOfB, distanceOfCentres, settings.weight),
                                     settings.contactAngle);
 }
@@ -103,7 +103,10 @@ bool bridgeCandidateRank(const BridgeCandidates& candidates, std::size_t k, cons
     if (!(ra > 0.0) || !(rb > 0.0) || !(distance > 0.0))
         throw RuntimeError("liquid bridges: candidate pair " + std::to_string(k) +
                            " has a non-positive radius or centre distance");
-    const double gap = distance - ra - rb;
+    // (ra + rb) first: the gap, and so λ*, is the same bits whichever particle
+    // is A (a pair across a slab face is a candidate on both ranks, each with
+    // its own particle first, and the cut of the ranking must treat both alike).
+    const double gap = distance - (ra + rb);
     if (settings.formation == BridgeFormation::ContactThenPersist && gap > 0.0 && !candidates.wasBonded[k])
         return false;  // no contact, no bridge yet
     weight = bridgeVolumeWeight(ra, rb, distance, settings.weight);

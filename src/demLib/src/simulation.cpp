@@ -570,9 +570,9 @@ void Simulation::updatePairList() {
     pairs_.setBridgeListing(settings_.bridges,
                             limitBridgePairs ? bridgeListingLimit_ : std::numeric_limits<double>::infinity());
     if (decomposition_) {
-        // A listed pair is closer than r_i + r_j + skin + extra <= 2 r_max +
+        // A listed pair is closer than r_i + r_j + skin + extra <= r_i + r_max +
         // skin + extra: ghosts out to that distance from the slab suffice.
-        decomposition_->appendGhosts(particles_, 2.0 * rMax + skin + extra);
+        decomposition_->appendGhosts(particles_, rMax + skin + extra);
         pairs_.build(particles_, ownedCount());
         decomposition_->restoreHistory(particles_, pairs_, wallContacts_);
     } else {

@@ -672,7 +672,7 @@ bool Simulation::readRestartDecomposed(const std::string& path) {
     double rMax = 0.0;
     for (double r : particles_.radius) rMax = std::max(rMax, r);
     rMax = comm.max(rMax);
-    decomposition_->appendGhosts(particles_, 2.0 * rMax + pairs_.skin() + pairs_.extraRange());
+    decomposition_->appendGhosts(particles_, rMax + pairs_.skin() + pairs_.extraRange());
     pairs_.restore(particles_, particles_.position, scalars.listBuildCount, owned);
     std::copy(d.position.begin(), d.position.end(), particles_.position.begin());
     decomposition_->updateGhosts(particles_);

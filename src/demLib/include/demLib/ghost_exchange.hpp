@@ -60,9 +60,10 @@ public:
     std::size_t migrate(ParticleStore& particles);
 
     // Appends, as ghosts, copies of the particles of other ranks whose centre
-    // lies within haloWidth of this rank's slab, and records what this rank
-    // sends to whom for updateGhosts.  Requires no ghosts.  Collective.
-    void appendGhosts(ParticleStore& particles, double haloWidth);
+    // lies within their own radius + reachBeyondRadius of this rank's slab,
+    // and records what this rank sends to whom for updateGhosts.  Requires no
+    // ghosts.  Collective.
+    void appendGhosts(ParticleStore& particles, double reachBeyondRadius);
 
     // After the pair list was built over owned + ghost particles: gives every
     // listed pair and every owned particle's wall contacts the stashed history
