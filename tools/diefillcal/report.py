@@ -53,7 +53,7 @@ def summarise(runner, outcome, wall_seconds):
         "fixed": {**runner.carried, **s.fixed},
         "surrogateScatter": {t.key: float(np.sqrt(m.noise_variance)) for t, m in zip(s.targets, surrogate.models)}
         if surrogate else {},
-        "agrees": bool(all(abs(y[k, j] - t.value) <= s.tolerance * t.sigma for j, t in enumerate(s.targets))),
+        "agrees": bool(runner.within_tolerance(y[k])),
     }
     _write_atomically(os.path.join(runner.folder, "result.json"), json.dumps(result, indent=1))
     if not s.parameters:
@@ -77,11 +77,10 @@ def choose(runner, x, y):
     best = int(np.argmin(misfits))
     if s.choose == "best" or not s.parameters:
         return best
-    agree = [i for i in range(len(y)) if all(abs(y[i, j] - t.value) <= s.tolerance * t.sigma
-                                              for j, t in enumerate(s.targets))]
+    agree = [i for i in range(len(y)) if runner.within_tolerance(y[i])]
     if not agree:
         return best
-    start = np.array([p.to_unit(v) for p, v in zip(s.parameters, runner.start_values())])
+    start = runner.start_unit()
     return min(agree, key=lambda i: float(np.sum((x[i] - start) ** 2)))
 
 

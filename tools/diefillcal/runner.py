@@ -5,6 +5,7 @@ import io
 import json
 import math
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -126,6 +127,14 @@ class StageRunner:
         source = casefile.source_file(self.s.case)
         return [float(self.carried.get(p.keyword, casefile.read_value(source, p.keyword))) for p in self.s.parameters]
 
+    def start_unit(self):
+        """start_values() in the unit cube (not clipped)."""
+        return np.array([p.to_unit(v) for p, v in zip(self.s.parameters, self.start_values())])
+
+    def within_tolerance(self, values):
+        """Whether one run's target values all lie within tolerance x sigma of the targets."""
+        return all(abs(v - t.value) <= self.s.tolerance * t.sigma for v, t in zip(values, self.s.targets))
+
     def misfit(self, values):
         return float(sum(((v - t.value) / t.sigma) ** 2 for v, t in zip(values, self.s.targets)))
 
@@ -148,8 +157,7 @@ class StageRunner:
         if d == 0:
             return np.zeros(0), "check at the earlier stages' values"
         if self.s.start_run and run_id == 1:
-            start = [p.to_unit(v) for p, v in zip(self.s.parameters, self.start_values())]
-            return np.clip(start, 0.0, 1.0), "the case's own values"
+            return np.clip(self.start_unit(), 0.0, 1.0), "the case's own values"
         if run_id <= self.s.first_runs:
             return self.design()[run_id - 1 - (self.s.first_runs - self.s.initial_runs)], "design"
         _, x, y = self.finished_ok()
@@ -282,8 +290,7 @@ class StageRunner:
         rows, x, y = self.finished_ok()
         if not rows:
             return False, False, None, None
-        k = int(np.argmin([self.misfit(v) for v in y]))
-        agrees = all(abs(v - t.value) <= self.s.tolerance * t.sigma for v, t in zip(y[k], self.s.targets))
+        agrees = self.within_tolerance(y[int(np.argmin([self.misfit(v) for v in y]))])
         if not self.s.parameters:
             return agrees, agrees, None, None
         if len(rows) < 2 or len(self.table.rows) < self.s.min_runs:
@@ -299,7 +306,7 @@ class StageRunner:
         point promises more than eiTolerance or the scatter floor."""
         misfits = [self.misfit(v) for v in y]
         k = int(np.argmin(misfits))
-        agrees = all(abs(v - t.value) <= self.s.tolerance * t.sigma for v, t in zip(y[k], self.s.targets))
+        agrees = self.within_tolerance(y[k])
         _, ei = method.propose(surrogate, np.vstack([x, self._failed_points()]), misfits[k], 1,
                                avoid=self._failed_points(), seed=self.c.seed)
         floor = float(sum(m.noise_variance / t.sigma ** 2 for m, t in zip(surrogate.models, self.s.targets)))
@@ -316,9 +323,8 @@ class StageRunner:
         ridge's point nearest the given values."""
         if self.s.choose != "nearest" or not self.s.parameters or len(self._runs_started_as(self.NEAREST)) >= self.s.nearest_runs:
             return None
-        start = np.array([p.to_unit(v) for p, v in zip(self.s.parameters, self.start_values())])
-        agree = [i for i in range(len(y)) if all(abs(y[i, j] - t.value) <= self.s.tolerance * t.sigma
-                                                  for j, t in enumerate(self.s.targets))]
+        start = self.start_unit()
+        agree = [i for i in range(len(y)) if self.within_tolerance(y[i])]
         nearest_run = min((float(np.sqrt(np.sum((x[i] - start) ** 2))) for i in agree), default=np.inf)
         q = method.nearest_agreeing(surrogate, start, self.s.tolerance, seed=self.c.seed)
         if q is None or float(np.sqrt(np.sum((q - start) ** 2))) > nearest_run - 0.05:
@@ -340,16 +346,9 @@ class StageRunner:
 
     def _runs_started_as(self, why):
         """Ids of the runs (finished or not) whose parameters file gives `why` as the reason."""
-        out = []
         runs = os.path.join(self.folder, "runs")
-        for name in sorted(os.listdir(runs)) if os.path.isdir(runs) else []:
-            try:
-                m = json.load(open(os.path.join(runs, name, RUN_PARAMETERS)))
-            except (OSError, ValueError):
-                continue
-            if m.get("why") == why:
-                out.append(int(m["run"]))
-        return out
+        ids = [int(n[3:]) for n in sorted(os.listdir(runs)) if re.fullmatch(r"run\d+", n)] if os.path.isdir(runs) else []
+        return [i for i in ids if self._marker_why(i) == why]
 
     def _stop_children(self, signum):
         for process, *_ in self.running.values():
