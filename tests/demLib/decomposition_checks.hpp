@@ -140,25 +140,35 @@ inline std::size_t straddlingContacts(const dem::Simulation& sim) {
     return count;
 }
 
+// Calls visit(i, k) for every owned particle i of the decomposed run whose id
+// the serial run holds, k its index there; returns how many owned ids it lacks.
+template <class Visit>
+std::int64_t forEachOwnedInSerial(const Runs& runs, Visit visit) {
+    const dem::ParticleStore& mine = runs.decomposed.particles();
+    const std::vector<long> index = indexById(runs.serial.particles(), static_cast<std::size_t>(runs.serial.nextId()));
+    std::int64_t missing = 0;
+    for (std::size_t i = 0; i < runs.decomposed.ownedCount(); ++i) {
+        const long k = index[static_cast<std::size_t>(mine.id[i])];
+        if (k < 0)
+            ++missing;
+        else
+            visit(i, static_cast<std::size_t>(k));
+    }
+    return missing;
+}
+
 // Largest force and torque deviation of the owned particles from the serial
 // run (by id), over all ranks, relative to the largest force and torque of the
 // serial bed.
 inline void expectLoadsMatch(const dem::Communicator& comm, const Runs& runs, const char* when) {
     const dem::ParticleStore& ref = runs.serial.particles();
     const dem::ParticleStore& mine = runs.decomposed.particles();
-    const std::vector<long> index = indexById(ref, static_cast<std::size_t>(runs.serial.nextId()));
     const auto [fScale, tScale] = largestLoads(ref);
     double fError = 0.0, tError = 0.0;
-    std::int64_t missing = 0;
-    for (std::size_t i = 0; i < runs.decomposed.ownedCount(); ++i) {
-        const long k = index[static_cast<std::size_t>(mine.id[i])];
-        if (k < 0) {
-            ++missing;
-            continue;
-        }
+    const std::int64_t missing = forEachOwnedInSerial(runs, [&](std::size_t i, std::size_t k) {
         fError = std::max(fError, (mine.force[i] - ref.force[k]).norm());
         tError = std::max(tError, (mine.torque[i] - ref.torque[k]).norm());
-    }
+    });
     fError = comm.max(fError);
     tError = comm.max(tError);
     EXPECT_EQ(comm.sum(missing), 0) << when;
@@ -335,18 +345,10 @@ inline std::int64_t wetStepsGoneWrong(const dem::Communicator& comm, Runs& runs,
 inline double positionErrorFromSerial(const dem::Communicator& comm, const Runs& runs, std::int64_t& unknown) {
     const dem::ParticleStore& ref = runs.serial.particles();
     const dem::ParticleStore& p = runs.decomposed.particles();
-    const std::vector<long> index = indexById(ref, static_cast<std::size_t>(runs.serial.nextId()));
     double xError = 0.0;
-    unknown = 0;
-    for (std::size_t i = 0; i < runs.decomposed.ownedCount(); ++i) {
-        const long k = index[static_cast<std::size_t>(p.id[i])];
-        if (k < 0) {
-            ++unknown;
-            continue;
-        }
+    unknown = comm.sum(forEachOwnedInSerial(runs, [&](std::size_t i, std::size_t k) {
         xError = std::max(xError, (p.position[i] - ref.position[k]).norm());
-    }
-    unknown = comm.sum(unknown);
+    }));
     return comm.max(xError);
 }
 
