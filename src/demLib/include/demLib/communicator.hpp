@@ -81,8 +81,8 @@ public:
     // already knows how many bytes it gets from each other rank
     // (receiveSizes[r]; 0: nothing from r, and r sends nothing), and
     // anyTrue(flag).  With MPI the reduction and the messages travel together
-    // (MPI_Iallreduce beside the point-to-point messages, one wait), instead of
-    // the three waits of anyTrue and exchange (sizes first, then data).
+    // (the point-to-point messages posted, the flag reduced, one wait), instead
+    // of the three waits of anyTrue and exchange (sizes first, then data).
     // A message of another size than announced is an error.  Collective.
     struct ExchangeAndFlag {
         std::vector<std::vector<char>> received;
