@@ -26,8 +26,12 @@ measured and what was expected, and exits 0 (pass) or 1 (fail).
   same A B TOL                               two figure files agree within TOL
 """
 import math
+import os
 import re
 import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tools"))
+from diefillpost import phasetimes  # noqa: E402
 
 VEC = r"\(([^()]*)\)"
 
@@ -370,29 +374,23 @@ def phases(args):
     exchanges lie within the DEM's time, each rank's figures within their least-most
     range; RANKS: 1 (serial) or the rank count named in the header."""
     log, ranks = args[0], int(args[1])
-    text = open(log).read()
-    m = re.search(r"Wall time of the time loop, ([0-9.e+-]+) s(?: \((\d+) ranks[^)]*\))?:\n((?:    .*\n)+)", text)
-    if not m:
+    table = phasetimes.parse(open(log).read())
+    if table is None:
         print("    no 'Wall time of the time loop' table in", log)
         return False
-    total, named = float(m.group(1)), int(m.group(2) or 1)
-    rows = {}
-    for line in m.group(3).splitlines():
-        r = re.match(r"\s{4}\s*(\S.*?)\s+([0-9.e+-]+) s\s+([0-9.]+) %(?:\s+\(([0-9.e+-]+) - ([0-9.e+-]+) s\))?", line)
-        if r:
-            rows[r.group(1).strip()] = [float(x) for x in r.groups()[1:] if x is not None]
-    phases = ["DEM (particle steps)", "coupling (void fraction, drag)", "air (PIMPLE loop)",
-              "output (fields, restart files)", "rest (time control, progress)"]
+    total, named, rows = table.total, table.ranks, table.rows
+    phases = list(phasetimes.PHASES.values())
     have = all(p in rows for p in phases)
     # Decomposed, each row is the most over ranks: their sum is at least the loop's time
     # of the slowest rank less its idle share; serially the rows are one rank's and add up.
-    added = sum(rows[p][0] for p in phases) if have else float("nan")
+    added = sum(rows[p].seconds for p in phases) if have else float("nan")
     sums = abs(added - total) <= 2e-3 * total + 1e-3 if ranks == 1 else added >= 0.999 * total - 1e-3
-    exchange = rows.get("of which in the DEM's exchanges")
-    within = ranks == 1 or (exchange is not None and exchange[0] <= rows["DEM (particle steps)"][0] * 1.0001 + 1e-4
-                            and all(r[2] <= r[3] * (1 + 1e-9) for r in rows.values()))
+    exchange = rows.get(phasetimes.EXCHANGES)
+    within = ranks == 1 or (exchange is not None
+                            and exchange.seconds <= rows["DEM (particle steps)"].seconds * 1.0001 + 1e-4
+                            and all(r.least is not None and r.least <= r.most * (1 + 1e-9) for r in rows.values()))
     print(f"    {len(rows)} rows, {named} rank(s) named (expected {ranks}); phases add up to {added:.4g} s "
-          f"against the loop's {total:.4g} s; DEM exchanges {exchange[0] if exchange else '-'} s")
+          f"against the loop's {total:.4g} s; DEM exchanges {exchange.seconds if exchange else '-'} s")
     return have and named == ranks and sums and within
 
 

@@ -764,6 +764,43 @@ def ladder_wall_time():
           abs(got - want) < 1e-9, f"(got {got} s, want {want} s)")
 
 
+@test
+def phase_table_of_diefillFoam():
+    """diefillFoam's wall-time table (phaseTimes.C) as printed serially and on 2 ranks, in a
+    log continued once (two tables: the last is the run's), read to the printed digits; a
+    log without one gives None.  The bench (bench/run) and tests/diefillFoam read it so."""
+    from diefillpost import phasetimes
+    serial = ("Wall time of the time loop, 9059 s:\n"
+              "    DEM (particle steps)                    8930 s  98.6 %\n"
+              "    coupling (void fraction, drag)         103.1 s   1.1 %\n"
+              "    air (PIMPLE loop)                       24.7 s   0.3 %\n"
+              "    output (fields, restart files)        0.1834 s   0.0 %\n"
+              "    rest (time control, progress)          0.589 s   0.0 %\n\nEnd\n")
+    ranks = ("Wall time of the time loop, 131.8 s (2 ranks: the most over ranks, and least - most):\n"
+             "    DEM (particle steps)                     111 s  84.2 %  (110.9 - 111 s)\n"
+             "      of which in the DEM's exchanges      16.93 s  12.9 %  (9.971 - 16.93 s)\n"
+             "    coupling (void fraction, drag)         9.609 s   7.3 %  (9.607 - 9.609 s)\n"
+             "    air (PIMPLE loop)                      10.75 s   8.2 %  (10.68 - 10.75 s)\n"
+             "    output (fields, restart files)      0.009358 s   0.0 %  (0.009231 - 0.009358 s)\n"
+             "    rest (time control, progress)         0.4755 s   0.4 %  (0.47 - 0.4755 s)\n\nEnd\n")
+    one = phasetimes.parse("Time = 5.2\n" + serial)
+    check("phase table, serial: total, one rank, the five phases to their digits, no range",
+          one is not None and one.total == 9059 and one.ranks == 1
+          and phasetimes.phase_seconds(one) == {"dem": 8930, "coupling": 103.1, "air": 24.7, "output": 0.1834,
+                                                "rest": 0.589}
+          and one.rows["air (PIMPLE loop)"].percent == 0.3 and one.rows["DEM (particle steps)"].least is None,
+          f"(total {one.total if one else None} s, {len(one.rows) if one else 0} rows)")
+    two = phasetimes.parse(serial.replace("9059", "1") + "Exec   : diefillFoam -parallel\n" + ranks)
+    ex = two.rows.get(phasetimes.EXCHANGES) if two else None
+    check("phase table, 2 ranks, second of two tables: total, ranks, exchanges and least - most",
+          two is not None and two.total == 131.8 and two.ranks == 2 and len(two.rows) == 6
+          and ex == (16.93, 12.9, 9.971, 16.93) and phasetimes.phase_seconds(two)["air"] == 10.75
+          and two.rows["output (fields, restart files)"].least == 0.009231,
+          f"(total {two.total if two else None} s, {len(two.rows) if two else 0} rows)")
+    check("phase table: a log without one gives None",
+          phasetimes.parse("Time = 1\nEnd\n") is None)
+
+
 import shutil  # noqa: E402
 
 shutil.rmtree(TMP, ignore_errors=True)

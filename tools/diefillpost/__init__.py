@@ -13,6 +13,7 @@ Modules (one concept each):
     cavity     a die cavity placed at the table, split into opening, floors and walls; the table
     shoemotion a shoe's motion from a table of time and position (translation segments)
     output     output files that replace the old ones only once complete
+    phasetimes diefillFoam's wall-time table (where the time loop went), for the bench and the tests
 """
 __all__ = ["foamdict", "series", "summary", "geometry", "profile", "plate", "plots", "results", "output",
-           "closedmesh", "cavity", "shoemotion"]
+           "closedmesh", "cavity", "shoemotion", "phasetimes"]
