@@ -718,11 +718,16 @@ def ladder_report_statistics():
         check("ladder report: mean 30 and sample sd 10 of 20, 30, 40", a["mean"] == 30.0 and a["sd"] == 10.0, f"{a}")
         check("ladder report: the wall time's mean (2 h) and the slope's count (3 of 3)",
               k1[0]["wallTime"]["mean"] == 7200.0 and k1[0]["slopeFallsAlongMotion"] == 3)
+        k2 = [e for e in ens if e["capillaryExponent"] == 2.0142]
+        check("ladder report: the bed's strength against the real powder's, l^(κ-1): 1 for κ = 1, "
+              "10^1.0142 = 10.3324 for the paper's exponent at coarse grain 10",
+              k1[0]["strengthRatio"] == 1.0 and len(k2) == 1 and k2[0]["strengthRatio"] == 10.3324,
+              f"({k1[0].get('strengthRatio')}, {k2[0].get('strengthRatio') if k2 else None})")
     text = open(readme).read()
     check("ladder report: the table replaces what stood between the markers, the rest kept",
           text.startswith("intro\n") and text.endswith("after\n") and "old" not in text
           and "30.0 ± 10.0" in text and "| cg10-k1-s2-air |" in text, text[:200])
-    for png in ("profiles.png", "fillRatio.png"):
+    for png in ("profiles.png", "fillRatio.png", "strength.png"):
         path = os.path.join(out, png)
         check(f"ladder report writes {png}", os.path.exists(path) and open(path, "rb").read(4) == b"\x89PNG")
     check_cmd = [sys.executable, LADDER, "report", "-check", "-runs", runs, "-out", out, "-readme", readme]
