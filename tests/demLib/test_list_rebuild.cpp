@@ -327,7 +327,7 @@ TEST(ParticleParticleNeighborList, ListsEveryPairOfAWidelyPolydisperseBed) {
 // trade places with the list's arrays on one thread, are replaced only when
 // they hold less than the old pairs and a sixteenth.  They were replaced at
 // every build whose count exceeded the one two builds before (+1.5 MB per
-// other build on the 50k bench bed, docs/performance.md round 13).
+// other build on the 50k bench bed, docs/performance-log.md, round 13).
 TEST(ParticleParticleNeighborList, MemoryStaysPutWhileThePairCountCreepsUp) {
     ThreadCount scope(1);
     const double radius = 1e-3, skin = 0.4e-3;

@@ -280,7 +280,7 @@ private:
     // not as short runs that jump back at each row.  Walking forwards, the
     // partners ahead were where a particle's data was first touched in the
     // step: scattered misses that go to memory once the bed outgrows the
-    // last-level cache (performance.md, round 9).
+    // last-level cache (docs/performance-log.md, round 9).
 
     // The scalar pair loop (settings_.vectorizedPairLaw = false): one contact
     // after the other through ContactLaw::evaluate; the reference of pairForcesBatched.
